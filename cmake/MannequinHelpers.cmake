@@ -1,0 +1,57 @@
+# Helpers shared by every target of the project.
+
+# Compile options every project target gets (warnings, sanitizers).
+add_library(mannequin_options INTERFACE)
+target_compile_options(mannequin_options INTERFACE -Wall -Wextra -Wpedantic)
+if(MANNEQUIN_WERROR)
+  target_compile_options(mannequin_options INTERFACE -Werror)
+endif()
+if(MANNEQUIN_SANITIZE)
+  target_compile_options(mannequin_options INTERFACE -fsanitize=${MANNEQUIN_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  target_link_options(mannequin_options INTERFACE -fsanitize=${MANNEQUIN_SANITIZE})
+endif()
+if(MANNEQUIN_CHECK_RUNTIME_MALLOC)
+  target_compile_definitions(mannequin_options INTERFACE EIGEN_RUNTIME_NO_MALLOC)
+endif()
+
+# mannequin_add_library(<name> SOURCES ... [DEPS ...] [PRIVATE_DEPS ...])
+# Creates target mannequin_<name> (alias mannequin::<name>) with headers in
+# libs/<name>/include/mannequin/<name>/.
+function(mannequin_add_library name)
+  cmake_parse_arguments(ARG "" "" "SOURCES;DEPS;PRIVATE_DEPS" ${ARGN})
+  add_library(mannequin_${name} STATIC ${ARG_SOURCES})
+  add_library(mannequin::${name} ALIAS mannequin_${name})
+  target_include_directories(mannequin_${name} PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/include)
+  target_link_libraries(mannequin_${name} PUBLIC ${ARG_DEPS} mannequin_options PRIVATE ${ARG_PRIVATE_DEPS})
+endfunction()
+
+# mannequin_add_test(<name> SOURCES ... LIBS ... LABELS ...)
+# One GoogleTest executable; each test case becomes a ctest test carrying LABELS.
+function(mannequin_add_test name)
+  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  add_executable(${name} ${ARG_SOURCES})
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} mannequin_options GTest::gtest GTest::gtest_main)
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin/tests)
+  if(NOT ARG_TIMEOUT)
+    set(ARG_TIMEOUT 300)
+  endif()
+  gtest_discover_tests(${name}
+    DISCOVERY_MODE PRE_TEST
+    WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
+    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+    ENVIRONMENT "MANNEQUIN_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+endfunction()
+
+# mannequin_add_bench(<area> SOURCES ... LIBS ...) -> build/bin/bench-<area>
+function(mannequin_add_bench area)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(bench-${area} ${ARG_SOURCES})
+  target_link_libraries(bench-${area} PRIVATE ${ARG_LIBS} mannequin_options benchmark::benchmark)
+endfunction()
+
+# mannequin_add_tool(<tool> SOURCES ... LIBS ...) -> build/bin/mannequin-<tool>
+function(mannequin_add_tool tool)
+  cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
+  add_executable(mannequin-${tool} ${ARG_SOURCES})
+  target_link_libraries(mannequin-${tool} PRIVATE ${ARG_LIBS} mannequin_options)
+endfunction()
