@@ -1,7 +1,7 @@
 #pragma once
 /// \file types.hpp
 /// \brief Eigen aliases shared by every mannequin library (scalar: double).
-#include <Eigen/Core>
+#include <Eigen/Dense>
 
 namespace mannequin::math {
 
