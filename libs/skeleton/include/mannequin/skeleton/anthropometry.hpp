@@ -1,0 +1,63 @@
+#pragma once
+/// \file anthropometry.hpp
+/// \brief Builds a mannequin Model from stature, mass and sex with published tables.
+///
+/// Sources (see docs/mannequin-model.md for the full tables and the choices made):
+/// - segment masses, centre-of-mass positions, radii of gyration and segment lengths:
+///   de Leva P. (1996), Adjustments to Zatsiorsky–Seluyanov's segment inertia parameters,
+///   J Biomech 29(9):1223–1230, Table 4 (male and female), lengths scaled by stature;
+/// - ankle height, hand length, shoulder and hip widths (not in de Leva):
+///   Drillis R., Contini R. (1966), Body segment parameters, Rep. 1166-03, New York University,
+///   as tabulated in Winter D.A., Biomechanics and Motor Control of Human Movement, Fig. 4.1;
+/// - joint ranges of motion: American Academy of Orthopaedic Surgeons (1965), Joint Motion:
+///   Method of Measuring and Recording (averages for adults).
+///
+/// The zero configuration is the anatomical posture (standing, arms along the body, palms
+/// forward). World and every joint frame at zero: x forward, y to the mannequin's left, z up.
+/// Segment names: pelvis, abdomen, thorax, head, clavicle_{l,r}, upper_arm_{l,r}, forearm_{l,r},
+/// hand_{l,r}, thigh_{l,r}, shank_{l,r}, foot_{l,r} (and toes_{l,r} when enabled).
+#include <map>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+#include "mannequin/skeleton/model.hpp"
+
+namespace mannequin::skeleton {
+
+enum class Sex { kMale, kFemale };
+
+/// What a mannequin config (configs/mannequins/*.yaml) specifies.
+struct MannequinSpec {
+  std::string name = "mannequin";
+  Sex sex = Sex::kMale;
+  double stature = 1.75;        ///< (m), vertex height standing
+  double mass = 75.0;           ///< (kg)
+  bool toes = false;            ///< add a toe segment and metatarsophalangeal joint per foot
+  double density = 1050.0;      ///< body density (kg/m³) used to size the collision capsules
+  /// Overrides of joint limits by coordinate name ("knee_l", "hip_l.y", ...), in degrees.
+  std::map<std::string, std::pair<double, double>> limits_deg;
+};
+
+/// An error in a config file: the message starts with "FILE:LINE: ".
+class ConfigError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// Builds the model. \throws std::invalid_argument for a stature outside [0.5, 2.5] m, a mass
+/// outside [10, 300] kg, a non-finite value, or a limit override naming an unknown coordinate.
+Model buildMannequin(const MannequinSpec& spec);
+
+/// Parses a mannequin config from YAML text; `source` names it in errors.
+/// \throws ConfigError naming source, line and the offending key or value.
+MannequinSpec parseMannequinSpec(const std::string& yaml_text, const std::string& source);
+
+/// Reads and parses a config file. \throws ConfigError (unreadable file included).
+MannequinSpec loadMannequinSpec(const std::string& path);
+
+/// Configuration standing on the floor z = 0: the neutral posture with the pelvis raised so the
+/// soles touch the floor.
+VectorX standingConfiguration(const Model& model);
+
+}  // namespace mannequin::skeleton

@@ -1,0 +1,138 @@
+#pragma once
+/// \file model.hpp
+/// \brief The mannequin's kinematic tree (joints, segments, frames) and its per-step buffers.
+///
+/// `Model` is built once (see anthropometry.hpp) and then only read; `Data` holds every buffer
+/// the algorithms write, preallocated from the Model so that the real-time loop never allocates
+/// (pinocchio's Model/Data, MuJoCo's mjModel/mjData).
+///
+/// Joints and their coordinates (thesis 1.13 and Annex D.1):
+/// - kRevolute (pivot): q ∈ R (rad), v = q̇; transform exp([ξ] q) about a unit axis ξ of the joint frame.
+/// - kBall: q ∈ so(3) ≅ R³, the rotation vector of the joint (R = exp([q]), Annex D.1);
+///   v ∈ R³ is the angular velocity of the child in its own frame (body frame).
+/// - kFreeFlyer (the root on SE(3)): q = (p, r) ∈ R³×R³, pose [exp(r), p] in the world;
+///   v = (ω, v) ∈ R⁶ is the body twist of the root (angular first, thesis convention).
+/// So nq == nv for every joint, but q is not a vector space: use integrate()/difference()
+/// (kinematics.hpp), never q + v.
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "mannequin/math/se3.hpp"
+
+namespace mannequin::skeleton {
+
+using math::Matrix3;
+using math::Matrix3X;
+using math::Matrix6X;
+using math::SE3;
+using math::Vector3;
+using math::Vector6;
+using math::VectorX;
+
+enum class JointType { kRevolute, kBall, kFreeFlyer };
+
+/// Name of a joint type as written in configs ("revolute", "ball", "free_flyer").
+const char* toString(JointType type);
+
+/// One joint of the tree; each joint carries a moving frame ("joint frame").
+struct Joint {
+  std::string name;
+  JointType type = JointType::kRevolute;
+  int parent = -1;                  ///< parent joint index, -1 for the world
+  SE3 placement;                    ///< joint frame in the parent joint frame at q = 0 (jMi(0))
+  Vector3 axis = Vector3::UnitZ();  ///< revolute only: unit axis ξ in the joint frame
+  int idx_q = 0;                    ///< first coordinate in q
+  int idx_v = 0;                    ///< first coordinate in v
+  int nq = 0;                       ///< coordinates (1, 3 or 6)
+  int nv = 0;                       ///< velocity coordinates (== nq)
+};
+
+/// A capsule for collision: the segment line from `a` to `b` (joint frame) swept by a sphere.
+struct Capsule {
+  Vector3 a = Vector3::Zero();  ///< first end of the axis, joint frame (m)
+  Vector3 b = Vector3::Zero();  ///< second end of the axis, joint frame (m)
+  double radius = 0.0;          ///< (m)
+  double length() const { return (b - a).norm(); }
+};
+
+/// A rigid segment (body) carried by a joint.
+struct Segment {
+  std::string name;
+  int joint = -1;                        ///< joint that carries it
+  double mass = 0.0;                     ///< (kg)
+  Vector3 com = Vector3::Zero();         ///< centre of mass in the joint frame (m)
+  Matrix3 inertia = Matrix3::Zero();     ///< inertia about the CoM, joint-frame axes (kg·m²)
+  double length = 0.0;                   ///< anatomical length used for scaling (m)
+  Capsule capsule;                       ///< collision capsule, joint frame
+};
+
+/// A named frame rigidly attached to a joint (control frames: hands, feet, pelvis, head...).
+struct Frame {
+  std::string name;
+  int joint = -1;   ///< joint whose frame carries it
+  SE3 placement;    ///< pose in the joint frame
+};
+
+/// The kinematic model: a tree of joints with segments and frames. Read-only after building.
+class Model {
+ public:
+  std::string name;
+  int nq = 0;  ///< configuration size
+  int nv = 0;  ///< velocity size (== nq)
+  std::vector<Joint> joints;      ///< parents always come before children
+  std::vector<Segment> segments;
+  std::vector<Frame> frames;
+  VectorX lower_limit;            ///< (nq) lower joint limits (rad; −inf where none)
+  VectorX upper_limit;            ///< (nq) upper joint limits
+  /// support[i]: joint indices from the root to joint i inclusive (the joints moving joint i).
+  std::vector<std::vector<int>> support;
+
+  /// Adds a joint under `parent` (−1 = world). \throws std::invalid_argument on a duplicate
+  /// name, an unknown parent, a zero revolute axis, or a second free flyer / a free flyer not at the root.
+  int addJoint(const std::string& name, JointType type, int parent, const SE3& placement,
+               const Vector3& axis = Vector3::UnitZ());
+  /// Adds a segment on a joint. \throws std::invalid_argument on a duplicate name, unknown joint,
+  /// negative or non-finite mass, or a non-symmetric / non-finite inertia.
+  int addSegment(const Segment& segment);
+  /// Adds a frame on a joint. \throws std::invalid_argument on a duplicate name or unknown joint.
+  int addFrame(const std::string& name, int joint, const SE3& placement);
+  /// Sets limits of one coordinate (rad). \throws std::invalid_argument if lower > upper or NaN.
+  void setLimits(int idx_q, double lower, double upper);
+
+  /// Index of a joint/segment/frame by name. \throws std::invalid_argument naming the missing
+  /// item and listing what exists.
+  int jointIndex(const std::string& name) const;
+  int segmentIndex(const std::string& name) const;
+  int frameIndex(const std::string& name) const;
+  /// Same, returning −1 when absent.
+  int findJoint(const std::string& name) const;
+  int findSegment(const std::string& name) const;
+  int findFrame(const std::string& name) const;
+
+  /// Total mass (kg).
+  double totalMass() const;
+  /// The neutral configuration (all zeros: root at the world origin, anatomical posture).
+  VectorX neutralConfiguration() const { return VectorX::Zero(nq); }
+  /// Names of the nq coordinates, e.g. "knee_l", "hip_l.x", "root.px" (for logs and files).
+  std::vector<std::string> coordinateNames() const;
+};
+
+/// Every buffer the kinematic algorithms write. Build one per Model and thread.
+struct Data {
+  explicit Data(const Model& model);
+
+  std::vector<SE3> liMi;     ///< (njoints) joint frame in its parent joint frame
+  std::vector<SE3> oMi;      ///< (njoints) joint frame in the world
+  std::vector<SE3> oMf;      ///< (nframes) frame poses in the world
+  Matrix6X J;                ///< (6 × nv) joint Jacobian columns in the WORLD frame (spatial twists
+                             ///< reduced at the world origin, thesis 1.22): V_{i/0(0)} = Σ_support J.col(k) v_k
+  Vector3 com = Vector3::Zero();   ///< centre of mass of the whole body, world (m)
+  Matrix3X Jcom;             ///< (3 × nv) CoM Jacobian, world frame (thesis 3.32–3.36)
+  std::vector<Vector3> segment_com;  ///< (nsegments) segment CoMs in the world
+  // scratch for the CoM Jacobian (subtree mass and first moment)
+  std::vector<double> subtree_mass;     ///< (njoints)
+  std::vector<Vector3> subtree_moment;  ///< (njoints) Σ m c over the subtree, world
+};
+
+}  // namespace mannequin::skeleton

@@ -1,0 +1,369 @@
+#include "mannequin/skeleton/anthropometry.hpp"
+
+#include <yaml-cpp/yaml.h>
+
+#include <cmath>
+#include <fstream>
+#include <set>
+#include <sstream>
+
+#include "mannequin/skeleton/kinematics.hpp"
+
+namespace mannequin::skeleton {
+
+namespace {
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kPi = 3.14159265358979323846;
+
+// ---- de Leva (1996) Table 4 -------------------------------------------------------------
+// mass: fraction of body mass; com: CoM position as a fraction of the length from the
+// ORIGIN endpoint (cranial for head/trunk, proximal for limbs, heel for the foot);
+// rg_*: radii of gyration as fractions of the length about the sagittal (x), transverse (y)
+// and longitudinal (z) axes; length: segment length of the reference sample (m).
+struct SegmentParams {
+  double mass, com, rg_sag, rg_trans, rg_long, length;
+};
+struct Table {
+  double stature;  // reference stature of the sample (m)
+  SegmentParams head, upper_trunk, mid_trunk, lower_trunk, upper_arm, forearm, hand, thigh, shank, foot;
+};
+// lengths: de Leva Table 4 (head: VERT–CERV is replaced by the remainder to the vertex,
+// hand: WJC–DA3 from Drillis & Contini 0.108 H); see docs/mannequin-model.md
+const Table kMale{1.741,
+                  {0.0694, 0.5002, 0.303, 0.315, 0.261, 0.0},
+                  {0.1596, 0.5066, 0.505, 0.320, 0.465, 0.1707},
+                  {0.1633, 0.4502, 0.482, 0.383, 0.468, 0.2155},
+                  {0.1117, 0.6115, 0.615, 0.551, 0.587, 0.1457},
+                  {0.0271, 0.5772, 0.285, 0.269, 0.158, 0.2817},
+                  {0.0162, 0.4574, 0.276, 0.265, 0.121, 0.2689},
+                  {0.0061, 0.3624, 0.288, 0.235, 0.184, 0.108 * 1.741},
+                  {0.1416, 0.4095, 0.329, 0.329, 0.149, 0.4222},
+                  {0.0433, 0.4459, 0.255, 0.249, 0.103, 0.4340},
+                  {0.0137, 0.4415, 0.257, 0.245, 0.124, 0.2581}};
+const Table kFemale{1.735,
+                    {0.0669, 0.4841, 0.271, 0.295, 0.261, 0.0},
+                    {0.1545, 0.5050, 0.466, 0.314, 0.449, 0.1425},
+                    {0.1465, 0.4512, 0.433, 0.354, 0.415, 0.2053},
+                    {0.1247, 0.4920, 0.433, 0.402, 0.444, 0.1815},
+                    {0.0255, 0.5754, 0.278, 0.260, 0.148, 0.2751},
+                    {0.0138, 0.4559, 0.261, 0.257, 0.094, 0.2643},
+                    {0.0056, 0.3427, 0.244, 0.208, 0.184, 0.108 * 1.735},
+                    {0.1478, 0.3612, 0.369, 0.364, 0.162, 0.3685},
+                    {0.0481, 0.4416, 0.271, 0.267, 0.093, 0.4323},
+                    {0.0129, 0.4014, 0.299, 0.279, 0.124, 0.2283}};
+
+// ---- Drillis & Contini (1966), fractions of stature ---------------------------------------
+constexpr double kAnkleHeight = 0.039;     // lateral malleolus height
+constexpr double kHipHalfWidth = 0.0535;   // half the distance between hip joint centres
+constexpr double kShoulderHalfWidth = 0.110;  // half the distance between shoulder joint centres
+constexpr double kShoulderDrop = 0.015;    // shoulder joint centre below the suprasternale
+constexpr double kHeelToAnkle = 0.22;      // ankle joint centre from the heel, fraction of foot length
+constexpr double kToeJoint = 0.75;         // metatarsophalangeal joint from the heel, fraction of foot length
+
+// ---- AAOS (1965) ranges of motion, degrees ---------------------------------------------
+// ball joints: [min, max] per component of the rotation vector in the joint frame, LEFT side
+struct BallLimits {
+  double x[2], y[2], z[2];
+};
+// trunk (thoracolumbar flexion 80, extension 25, lateral bending 35, rotation 45) split in two
+const BallLimits kLumbar{{-17.5, 17.5}, {-12.5, 40}, {-22.5, 22.5}};
+const BallLimits kThoracic{{-17.5, 17.5}, {-12.5, 40}, {-22.5, 22.5}};
+// cervical: flexion 45, extension 45, lateral bending 45, rotation 60
+const BallLimits kNeck{{-45, 45}, {-45, 45}, {-60, 60}};
+// shoulder: abduction 180 (+x), adduction 30, flexion 180 (−y), extension 60, internal 70 (−z), external 90
+// (180° capped at 170° to stay clear of the rotation-vector singularity at π)
+const BallLimits kShoulder{{-30, 170}, {-170, 60}, {-70, 90}};
+// hip: abduction 45 (+x), adduction 30, flexion 120 (−y), extension 30, internal 45 (−z), external 45
+const BallLimits kHip{{-30, 45}, {-120, 30}, {-45, 45}};
+
+// ---- helpers ----------------------------------------------------------------------------
+Vector3 mirror(const Vector3& v) { return Vector3(v.x(), -v.y(), v.z()); }
+// a rotation axis is a pseudo-vector: its mirror image through the sagittal plane
+Vector3 mirrorAxis(const Vector3& a) { return Vector3(-a.x(), a.y(), -a.z()); }
+
+SE3 at(const Vector3& p) { return SE3(math::Matrix3::Identity(), p); }
+
+struct Builder {
+  Model& model;
+  const MannequinSpec& spec;
+  double density;
+
+  double radiusFor(double mass, double length) const {
+    if (mass <= 0 || length <= 0) return 0.0;
+    return std::sqrt(mass / (density * kPi * length));
+  }
+
+  // segment along the joint frame from `a` to `b`; com at fraction `c` from `a`
+  void segment(const std::string& name, int joint, const SegmentParams& t, double length, const Vector3& a,
+               const Vector3& b, double radius = -1.0) {
+    Segment s;
+    s.name = name;
+    s.joint = joint;
+    s.mass = t.mass * spec.mass;
+    s.length = length;
+    s.com = a + t.com * (b - a);
+    s.inertia = s.mass * Vector3(std::pow(t.rg_sag * length, 2), std::pow(t.rg_trans * length, 2),
+                                 std::pow(t.rg_long * length, 2)).asDiagonal();
+    s.capsule.a = a;
+    s.capsule.b = b;
+    s.capsule.radius = radius >= 0 ? radius : radiusFor(s.mass, length);
+    model.addSegment(s);
+  }
+
+  void massless(const std::string& name, int joint, const Vector3& a, const Vector3& b, double radius) {
+    Segment s;
+    s.name = name;
+    s.joint = joint;
+    s.length = (b - a).norm();
+    s.capsule.a = a;
+    s.capsule.b = b;
+    s.capsule.radius = radius;
+    model.addSegment(s);
+  }
+
+  void ballLimits(int joint, const BallLimits& l, bool right) {
+    const int i = model.joints[joint].idx_q;
+    // mirroring a rotation vector negates its x and z components
+    const auto set = [&](int k, const double* r, bool flip) {
+      if (flip) model.setLimits(i + k, -r[1] * kDeg, -r[0] * kDeg);
+      else model.setLimits(i + k, r[0] * kDeg, r[1] * kDeg);
+    };
+    set(0, l.x, right);
+    set(1, l.y, false);
+    set(2, l.z, right);
+  }
+
+  int revolute(const std::string& name, int parent, const Vector3& offset, const Vector3& axis_left, bool right,
+               double lo_deg, double hi_deg) {
+    const int j = model.addJoint(name, JointType::kRevolute, parent, at(offset), right ? mirrorAxis(axis_left) : axis_left);
+    model.setLimits(model.joints[j].idx_q, lo_deg * kDeg, hi_deg * kDeg);
+    return j;
+  }
+};
+
+void checkSpec(const MannequinSpec& spec) {
+  const auto bad = [&](const std::string& what) {
+    throw std::invalid_argument("mannequin '" + spec.name + "': " + what);
+  };
+  if (!std::isfinite(spec.stature) || spec.stature < 0.5 || spec.stature > 2.5)
+    bad("stature " + std::to_string(spec.stature) + " m is outside [0.5, 2.5] m");
+  if (!std::isfinite(spec.mass) || spec.mass < 10 || spec.mass > 300)
+    bad("mass " + std::to_string(spec.mass) + " kg is outside [10, 300] kg");
+  if (!std::isfinite(spec.density) || spec.density < 500 || spec.density > 2000)
+    bad("density " + std::to_string(spec.density) + " kg/m^3 is outside [500, 2000]");
+}
+}  // namespace
+
+Model buildMannequin(const MannequinSpec& spec) {
+  checkSpec(spec);
+  const Table& T = spec.sex == Sex::kMale ? kMale : kFemale;
+  const double H = spec.stature;
+  const double k = H / T.stature;  // scale of de Leva's lengths
+
+  // lengths (m)
+  const double ankle_h = kAnkleHeight * H;
+  const double shank = T.shank.length * k, thigh = T.thigh.length * k;
+  const double lpt = T.lower_trunk.length * k, mpt = T.mid_trunk.length * k, upt = T.upper_trunk.length * k;
+  const double hip_h = ankle_h + shank + thigh;
+  const double head = H - (hip_h + lpt + mpt + upt);  // suprasternale → vertex
+  const double upper_arm = T.upper_arm.length * k, forearm = T.forearm.length * k, hand = T.hand.length * k;
+  const double foot = T.foot.length * k;
+
+  Model model;
+  model.name = spec.name;
+  Builder b{model, spec, spec.density};
+
+  // trunk and head: pelvis (root) → lumbar → thoracic → neck, segments along +z
+  const int root = model.addJoint("root", JointType::kFreeFlyer, -1, SE3::Identity());
+  {
+    // the pelvis capsule lies across, between the hip joint centres
+    Segment s;
+    b.segment("pelvis", root, T.lower_trunk, lpt, Vector3(0, 0, lpt), Vector3(0, 0, 0));
+    Segment& pelvis = model.segments.back();
+    const double w = kHipHalfWidth * H;
+    pelvis.capsule.a = Vector3(0, w, 0.5 * lpt);
+    pelvis.capsule.b = Vector3(0, -w, 0.5 * lpt);
+    pelvis.capsule.radius = b.radiusFor(pelvis.mass, 2 * w + lpt);
+  }
+  const int lumbar = model.addJoint("lumbar", JointType::kBall, root, at({0, 0, lpt}));
+  b.ballLimits(lumbar, kLumbar, false);
+  b.segment("abdomen", lumbar, T.mid_trunk, mpt, Vector3(0, 0, mpt), Vector3(0, 0, 0));
+  const int thoracic = model.addJoint("thoracic", JointType::kBall, lumbar, at({0, 0, mpt}));
+  b.ballLimits(thoracic, kThoracic, false);
+  b.segment("thorax", thoracic, T.upper_trunk, upt, Vector3(0, 0, upt), Vector3(0, 0, 0));
+  const int neck = model.addJoint("neck", JointType::kBall, thoracic, at({0, 0, upt}));
+  b.ballLimits(neck, kNeck, false);
+  b.segment("head", neck, T.head, head, Vector3(0, 0, head), Vector3(0, 0, 0));
+  model.addFrame("head_top", neck, at({0, 0, head}));
+
+  for (bool right : {false, true}) {
+    const std::string s = right ? "_r" : "_l";
+    const auto side = [&](const Vector3& v) { return right ? mirror(v) : v; };
+
+    // shoulder girdle: clavicle elevation at the suprasternale (massless; its mass is in the thorax)
+    const int clav = b.revolute("sternoclavicular" + s, thoracic, Vector3(0, 0, upt), Vector3::UnitX(), right, -10, 30);
+    const Vector3 sjc = side(Vector3(0, kShoulderHalfWidth * H, -kShoulderDrop * H));
+    b.massless("clavicle" + s, clav, Vector3::Zero(), sjc, 0.03 * H / 1.75);
+
+    // arm: shoulder (ball), elbow flexion, forearm pronation, wrist flexion and deviation
+    const int shoulder = model.addJoint("shoulder" + s, JointType::kBall, clav, at(sjc));
+    b.ballLimits(shoulder, kShoulder, right);
+    b.segment("upper_arm" + s, shoulder, T.upper_arm, upper_arm, Vector3::Zero(), Vector3(0, 0, -upper_arm));
+    const int elbow = b.revolute("elbow" + s, shoulder, Vector3(0, 0, -upper_arm), -Vector3::UnitY(), right, 0, 150);
+    // pronation 80 + supination 80 around mid-position; zero here is full supination (palms forward)
+    const int radioulnar = b.revolute("radioulnar" + s, elbow, Vector3::Zero(), -Vector3::UnitZ(), right, 0, 160);
+    b.segment("forearm" + s, radioulnar, T.forearm, forearm, Vector3::Zero(), Vector3(0, 0, -forearm));
+    const int wrist = b.revolute("wrist" + s, radioulnar, Vector3(0, 0, -forearm), -Vector3::UnitY(), right, -70, 80);
+    const int wrist_dev = b.revolute("wrist_deviation" + s, wrist, Vector3::Zero(), Vector3::UnitX(), right, -30, 20);
+    b.segment("hand" + s, wrist_dev, T.hand, hand, Vector3::Zero(), Vector3(0, 0, -hand));
+    model.addFrame("palm" + s, wrist_dev, at({0.02 * H / 1.75, 0, -0.45 * hand}));
+
+    // leg: hip (ball), knee flexion, ankle dorsiflexion and subtalar inversion
+    const int hip = model.addJoint("hip" + s, JointType::kBall, root, at(side(Vector3(0, kHipHalfWidth * H, 0))));
+    b.ballLimits(hip, kHip, right);
+    b.segment("thigh" + s, hip, T.thigh, thigh, Vector3::Zero(), Vector3(0, 0, -thigh));
+    const int knee = b.revolute("knee" + s, hip, Vector3(0, 0, -thigh), Vector3::UnitY(), right, 0, 135);
+    b.segment("shank" + s, knee, T.shank, shank, Vector3::Zero(), Vector3(0, 0, -shank));
+    const int ankle = b.revolute("ankle" + s, knee, Vector3(0, 0, -shank), -Vector3::UnitY(), right, -50, 20);
+    const int subtalar = b.revolute("subtalar" + s, ankle, Vector3::Zero(), -Vector3::UnitX(), right, -15, 35);
+    // the foot runs from the heel to the toe tip along x, its capsule resting on the sole
+    const double foot_r = b.radiusFor(T.foot.mass * spec.mass, foot);
+    const Vector3 heel(-kHeelToAnkle * foot, 0, -ankle_h + foot_r);
+    const Vector3 toe(heel.x() + (spec.toes ? kToeJoint : 1.0) * foot, 0, heel.z());
+    b.segment("foot" + s, subtalar, T.foot, foot, heel, Vector3(heel.x() + foot, 0, heel.z()), foot_r);
+    model.segments.back().capsule.b = toe;
+    model.addFrame("sole" + s, subtalar, at({heel.x() + 0.5 * foot, 0, -ankle_h}));
+    if (spec.toes) {
+      const int mtp = b.revolute("toes" + s, subtalar, toe, -Vector3::UnitY(), right, -45, 70);
+      b.massless("toes" + s, mtp, Vector3::Zero(), Vector3((1.0 - kToeJoint) * foot, 0, 0), 0.8 * foot_r);
+    }
+  }
+
+  // a frame at each segment's joint, named after the segment (control frames: pelvis, head, hand_l ...)
+  for (const Segment& seg : std::vector<Segment>(model.segments))
+    if (model.findFrame(seg.name) < 0) model.addFrame(seg.name, seg.joint, SE3::Identity());
+
+  // overrides of joint limits, by coordinate name
+  const auto names = model.coordinateNames();
+  for (const auto& [coord, lim] : spec.limits_deg) {
+    const auto it = std::find(names.begin(), names.end(), coord);
+    if (it == names.end())
+      throw std::invalid_argument("mannequin '" + spec.name + "': joint limit override for unknown coordinate '" +
+                                  coord + "'");
+    model.setLimits(static_cast<int>(it - names.begin()), lim.first * kDeg, lim.second * kDeg);
+  }
+  return model;
+}
+
+VectorX standingConfiguration(const Model& model) {
+  VectorX q = model.neutralConfiguration();
+  Data data(model);
+  forwardKinematics(model, data, q);
+  const int sole = model.findFrame("sole_l");
+  const int root = 0;
+  if (sole >= 0 && !model.joints.empty() && model.joints[root].type == JointType::kFreeFlyer)
+    q(model.joints[root].idx_q + 2) = -data.oMf[sole].p.z();
+  return q;
+}
+
+// ---- YAML config ------------------------------------------------------------------------
+namespace {
+[[noreturn]] void configFail(const std::string& source, const YAML::Node& node, const std::string& msg) {
+  const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
+  throw ConfigError(source + ":" + std::to_string(line) + ": " + msg);
+}
+
+double readNumber(const std::string& source, const YAML::Node& node, const std::string& key) {
+  try {
+    const double v = node.as<double>();
+    if (!std::isfinite(v)) configFail(source, node, "'" + key + "' must be a finite number");
+    return v;
+  } catch (const YAML::Exception&) {
+    configFail(source, node, "'" + key + "' must be a number, got '" + YAML::Dump(node) + "'");
+  }
+}
+}  // namespace
+
+MannequinSpec parseMannequinSpec(const std::string& text, const std::string& source) {
+  YAML::Node root;
+  try {
+    root = YAML::Load(text);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
+  }
+  if (!root.IsMap()) throw ConfigError(source + ":1: expected a mapping of keys (name, sex, stature_m, mass_kg, ...)");
+
+  static const std::set<std::string> kKeys = {"name", "sex", "stature_m", "mass_kg", "toes", "density_kg_m3",
+                                              "joint_limits_deg", "description", "source"};
+  MannequinSpec spec;
+  bool has_sex = false, has_stature = false, has_mass = false;
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    const YAML::Node& v = kv.second;
+    if (!kKeys.count(key)) {
+      configFail(source, kv.first, "unknown key '" + key +
+                                       "' (expected name, sex, stature_m, mass_kg, toes, density_kg_m3, "
+                                       "joint_limits_deg, description, source)");
+    }
+    if (key == "name") {
+      spec.name = v.as<std::string>();
+    } else if (key == "sex") {
+      const std::string s = v.IsScalar() ? v.as<std::string>() : "";
+      if (s == "male") spec.sex = Sex::kMale;
+      else if (s == "female") spec.sex = Sex::kFemale;
+      else configFail(source, v, "'sex' must be 'male' or 'female', got '" + YAML::Dump(v) + "'");
+      has_sex = true;
+    } else if (key == "stature_m") {
+      spec.stature = readNumber(source, v, key);
+      if (spec.stature < 0.5 || spec.stature > 2.5)
+        configFail(source, v, "'stature_m' = " + YAML::Dump(v) + " is outside [0.5, 2.5] m");
+      has_stature = true;
+    } else if (key == "mass_kg") {
+      spec.mass = readNumber(source, v, key);
+      if (spec.mass < 10 || spec.mass > 300)
+        configFail(source, v, "'mass_kg' = " + YAML::Dump(v) + " is outside [10, 300] kg");
+      has_mass = true;
+    } else if (key == "density_kg_m3") {
+      spec.density = readNumber(source, v, key);
+      if (spec.density < 500 || spec.density > 2000)
+        configFail(source, v, "'density_kg_m3' = " + YAML::Dump(v) + " is outside [500, 2000]");
+    } else if (key == "toes") {
+      try {
+        spec.toes = v.as<bool>();
+      } catch (const YAML::Exception&) {
+        configFail(source, v, "'toes' must be true or false");
+      }
+    } else if (key == "joint_limits_deg") {
+      if (!v.IsMap()) configFail(source, v, "'joint_limits_deg' must map coordinate names to [min, max]");
+      for (const auto& lim : v) {
+        const std::string coord = lim.first.as<std::string>();
+        const YAML::Node& r = lim.second;
+        if (!r.IsSequence() || r.size() != 2)
+          configFail(source, r, "joint limit '" + coord + "' must be [min, max] in degrees");
+        const double lo = readNumber(source, r[0], coord), hi = readNumber(source, r[1], coord);
+        if (lo > hi) configFail(source, r, "joint limit '" + coord + "': min > max");
+        spec.limits_deg[coord] = {lo, hi};
+      }
+    }
+  }
+  if (!has_sex) throw ConfigError(source + ":1: missing key 'sex' (male or female)");
+  if (!has_stature) throw ConfigError(source + ":1: missing key 'stature_m'");
+  if (!has_mass) throw ConfigError(source + ":1: missing key 'mass_kg'");
+  // unknown coordinate names in overrides are reported with the file name
+  try {
+    buildMannequin(spec);
+  } catch (const std::invalid_argument& e) {
+    throw ConfigError(source + ":1: " + e.what());
+  }
+  return spec;
+}
+
+MannequinSpec loadMannequinSpec(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw ConfigError(path + ":0: cannot open mannequin config");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return parseMannequinSpec(ss.str(), path);
+}
+
+}  // namespace mannequin::skeleton

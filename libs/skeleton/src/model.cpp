@@ -1,0 +1,159 @@
+#include "mannequin/skeleton/model.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+namespace mannequin::skeleton {
+
+namespace {
+[[noreturn]] void fail(const std::string& msg) { throw std::invalid_argument(msg); }
+
+template <class Items>
+int findByName(const Items& items, const std::string& name) {
+  for (size_t i = 0; i < items.size(); ++i)
+    if (items[i].name == name) return static_cast<int>(i);
+  return -1;
+}
+
+template <class Items>
+std::string listNames(const Items& items) {
+  std::string out;
+  for (size_t i = 0; i < items.size() && i < 60; ++i) out += (i ? ", " : "") + items[i].name;
+  if (items.size() > 60) out += ", ...";
+  return out;
+}
+}  // namespace
+
+const char* toString(JointType type) {
+  switch (type) {
+    case JointType::kRevolute: return "revolute";
+    case JointType::kBall: return "ball";
+    case JointType::kFreeFlyer: return "free_flyer";
+  }
+  return "?";
+}
+
+int Model::addJoint(const std::string& jname, JointType type, int parent, const SE3& placement,
+                    const Vector3& axis) {
+  if (jname.empty()) fail("joint name is empty");
+  if (findJoint(jname) >= 0) fail("joint '" + jname + "' is defined twice");
+  if (parent < -1 || parent >= static_cast<int>(joints.size()))
+    fail("joint '" + jname + "': parent index " + std::to_string(parent) + " does not exist");
+  if (!placement.allFinite() || !math::isRotation(placement.R, 1e-6))
+    fail("joint '" + jname + "': placement is not a finite rigid transform");
+  if (type == JointType::kFreeFlyer && (parent != -1 || !joints.empty()))
+    fail("joint '" + jname + "': a free flyer must be the first joint, attached to the world");
+  Joint j;
+  j.name = jname;
+  j.type = type;
+  j.parent = parent;
+  j.placement = placement;
+  if (type == JointType::kRevolute) {
+    if (!axis.allFinite() || axis.norm() < 1e-9) fail("joint '" + jname + "': revolute axis is zero or not finite");
+    j.axis = axis.normalized();
+  }
+  j.nq = j.nv = (type == JointType::kRevolute ? 1 : type == JointType::kBall ? 3 : 6);
+  j.idx_q = nq;
+  j.idx_v = nv;
+  nq += j.nq;
+  nv += j.nv;
+  joints.push_back(j);
+  // limits: none by default
+  lower_limit.conservativeResize(nq);
+  upper_limit.conservativeResize(nq);
+  lower_limit.tail(j.nq).setConstant(-std::numeric_limits<double>::infinity());
+  upper_limit.tail(j.nq).setConstant(std::numeric_limits<double>::infinity());
+  // support chain
+  std::vector<int> chain = parent >= 0 ? support[parent] : std::vector<int>{};
+  chain.push_back(static_cast<int>(joints.size()) - 1);
+  support.push_back(std::move(chain));
+  return static_cast<int>(joints.size()) - 1;
+}
+
+int Model::addSegment(const Segment& s) {
+  if (s.name.empty()) fail("segment name is empty");
+  if (findSegment(s.name) >= 0) fail("segment '" + s.name + "' is defined twice");
+  if (s.joint < 0 || s.joint >= static_cast<int>(joints.size()))
+    fail("segment '" + s.name + "': joint index " + std::to_string(s.joint) + " does not exist");
+  if (!std::isfinite(s.mass) || s.mass < 0) fail("segment '" + s.name + "': mass must be finite and >= 0");
+  if (!s.com.allFinite() || !s.inertia.allFinite() || !s.inertia.isApprox(s.inertia.transpose(), 1e-9))
+    fail("segment '" + s.name + "': centre of mass or inertia is not finite/symmetric");
+  if (!std::isfinite(s.capsule.radius) || s.capsule.radius < 0 || !s.capsule.a.allFinite() || !s.capsule.b.allFinite())
+    fail("segment '" + s.name + "': capsule radius must be finite and >= 0");
+  segments.push_back(s);
+  return static_cast<int>(segments.size()) - 1;
+}
+
+int Model::addFrame(const std::string& fname, int joint, const SE3& placement) {
+  if (fname.empty()) fail("frame name is empty");
+  if (findFrame(fname) >= 0) fail("frame '" + fname + "' is defined twice");
+  if (joint < 0 || joint >= static_cast<int>(joints.size()))
+    fail("frame '" + fname + "': joint index " + std::to_string(joint) + " does not exist");
+  if (!placement.allFinite()) fail("frame '" + fname + "': placement is not finite");
+  frames.push_back(Frame{fname, joint, placement});
+  return static_cast<int>(frames.size()) - 1;
+}
+
+void Model::setLimits(int idx_q, double lower, double upper) {
+  if (idx_q < 0 || idx_q >= nq) fail("limit index " + std::to_string(idx_q) + " is outside [0, nq)");
+  if (std::isnan(lower) || std::isnan(upper) || lower > upper)
+    fail("coordinate " + std::to_string(idx_q) + ": limits [" + std::to_string(lower) + ", " +
+         std::to_string(upper) + "] are not an interval");
+  lower_limit(idx_q) = lower;
+  upper_limit(idx_q) = upper;
+}
+
+int Model::findJoint(const std::string& n) const { return findByName(joints, n); }
+int Model::findSegment(const std::string& n) const { return findByName(segments, n); }
+int Model::findFrame(const std::string& n) const { return findByName(frames, n); }
+
+int Model::jointIndex(const std::string& n) const {
+  const int i = findJoint(n);
+  if (i < 0) fail("unknown joint '" + n + "' in mannequin '" + name + "' (joints: " + listNames(joints) + ")");
+  return i;
+}
+int Model::segmentIndex(const std::string& n) const {
+  const int i = findSegment(n);
+  if (i < 0) fail("unknown segment '" + n + "' in mannequin '" + name + "' (segments: " + listNames(segments) + ")");
+  return i;
+}
+int Model::frameIndex(const std::string& n) const {
+  const int i = findFrame(n);
+  if (i < 0) fail("unknown frame '" + n + "' in mannequin '" + name + "' (frames: " + listNames(frames) + ")");
+  return i;
+}
+
+double Model::totalMass() const {
+  double m = 0;
+  for (const auto& s : segments) m += s.mass;
+  return m;
+}
+
+std::vector<std::string> Model::coordinateNames() const {
+  std::vector<std::string> names;
+  names.reserve(nq);
+  for (const auto& j : joints) {
+    switch (j.type) {
+      case JointType::kRevolute: names.push_back(j.name); break;
+      case JointType::kBall:
+        for (const char* c : {".x", ".y", ".z"}) names.push_back(j.name + c);
+        break;
+      case JointType::kFreeFlyer:
+        for (const char* c : {".px", ".py", ".pz", ".rx", ".ry", ".rz"}) names.push_back(j.name + c);
+        break;
+    }
+  }
+  return names;
+}
+
+Data::Data(const Model& model)
+    : liMi(model.joints.size()),
+      oMi(model.joints.size()),
+      oMf(model.frames.size()),
+      J(Matrix6X::Zero(6, model.nv)),
+      Jcom(Matrix3X::Zero(3, model.nv)),
+      segment_com(model.segments.size(), Vector3::Zero()),
+      subtree_mass(model.joints.size(), 0.0),
+      subtree_moment(model.joints.size(), Vector3::Zero()) {}
+
+}  // namespace mannequin::skeleton

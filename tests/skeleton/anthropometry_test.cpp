@@ -1,0 +1,162 @@
+#include "mannequin/skeleton/anthropometry.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdlib>
+
+#include "mannequin/skeleton/kinematics.hpp"
+
+using namespace mannequin::skeleton;
+
+namespace {
+constexpr double kDeg = 3.14159265358979323846 / 180.0;
+
+std::string configPath(const std::string& name) {
+  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
+  return std::string(root ? root : ".") + "/configs/mannequins/" + name;
+}
+
+std::string configError(const std::string& yaml) {
+  try {
+    parseMannequinSpec(yaml, "test.yaml");
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+struct Built {
+  Model m;
+  Data d;
+  explicit Built(const MannequinSpec& s) : m(buildMannequin(s)), d(m) {}
+  void at(const VectorX& q) {
+    computeJointJacobians(m, d, q);
+    jacobianCenterOfMass(m, d);
+  }
+  Vector3 joint(const std::string& n) const { return d.oMi[m.jointIndex(n)].p; }
+};
+}  // namespace
+
+TEST(Anthropometry, ShippedConfigsBuildWithTheirStatureAndMass) {
+  for (const char* file : {"female_05th.yaml", "male_50th.yaml", "male_95th.yaml"}) {
+    SCOPED_TRACE(file);
+    const MannequinSpec spec = loadMannequinSpec(configPath(file));
+    Built b(spec);
+    EXPECT_NEAR(b.m.totalMass(), spec.mass, 1e-9);  // de Leva fractions sum to 1
+    b.at(standingConfiguration(b.m));
+    // standing: soles on the floor, vertex at the stature
+    EXPECT_NEAR(b.d.oMf[b.m.frameIndex("sole_l")].p.z(), 0.0, 1e-12);
+    EXPECT_NEAR(b.d.oMf[b.m.frameIndex("head_top")].p.z(), spec.stature, 1e-12);
+    // whole-body CoM of an upright adult: about 55–57 % of stature, on the sagittal plane
+    EXPECT_GT(b.d.com.z(), 0.53 * spec.stature);
+    EXPECT_LT(b.d.com.z(), 0.60 * spec.stature);
+    EXPECT_NEAR(b.d.com.y(), 0.0, 1e-12);
+    // every segment with mass has a positive capsule, and the CoM lies between its ends
+    for (const Segment& s : b.m.segments) {
+      EXPECT_GT(s.capsule.radius, 0.005) << s.name;
+      EXPECT_LT(s.capsule.radius, 0.25) << s.name;
+    }
+  }
+}
+
+TEST(Anthropometry, DegreesOfFreedomLikeThesisFigure15) {
+  MannequinSpec spec;
+  Built b(spec);
+  EXPECT_EQ(b.m.nv - 6, 37);  // internal DoF without toes (thesis Fig. 1.5 has 36)
+  spec.toes = true;
+  EXPECT_EQ(buildMannequin(spec).nv - 6, 39);
+  for (const char* f : {"pelvis", "head", "hand_l", "hand_r", "foot_l", "foot_r", "palm_l", "sole_r"})
+    EXPECT_GE(b.m.findFrame(f), 0) << f;
+}
+
+TEST(Anthropometry, SegmentParametersFollowDeLeva) {
+  MannequinSpec spec;
+  spec.sex = Sex::kMale;
+  spec.mass = 80.0;
+  spec.stature = 1.741;  // de Leva's reference stature: lengths are the table's
+  Built b(spec);
+  const Segment& thigh = b.m.segments[b.m.segmentIndex("thigh_l")];
+  EXPECT_NEAR(thigh.mass, 0.1416 * 80.0, 1e-12);
+  EXPECT_NEAR(thigh.length, 0.4222, 1e-12);
+  EXPECT_NEAR(-thigh.com.z(), 0.4095 * 0.4222, 1e-12);                      // from the hip joint centre
+  EXPECT_NEAR(thigh.inertia(0, 0), 0.1416 * 80.0 * std::pow(0.329 * 0.4222, 2), 1e-12);
+  EXPECT_NEAR(thigh.inertia(2, 2), 0.1416 * 80.0 * std::pow(0.149 * 0.4222, 2), 1e-12);
+  spec.sex = Sex::kFemale;
+  const Model f = buildMannequin(spec);
+  EXPECT_NEAR(f.segments[f.segmentIndex("thigh_r")].mass, 0.1478 * 80.0, 1e-12);
+  // lengths scale with stature
+  spec.stature = 1.2 * 1.735;
+  const Model big = buildMannequin(spec);
+  EXPECT_NEAR(big.segments[big.segmentIndex("shank_l")].length, 1.2 * 0.4323, 1e-12);
+}
+
+TEST(Anthropometry, LimitsAreTheRangeOfMotionTableMirrored) {
+  const Model m = buildMannequin(MannequinSpec{});
+  const auto names = m.coordinateNames();
+  const auto limits = [&](const std::string& c) {
+    const int i = static_cast<int>(std::find(names.begin(), names.end(), c) - names.begin());
+    return std::pair{m.lower_limit(i) / kDeg, m.upper_limit(i) / kDeg};
+  };
+  EXPECT_NEAR(limits("knee_l").first, 0.0, 1e-9);
+  EXPECT_NEAR(limits("knee_l").second, 135.0, 1e-9);
+  EXPECT_NEAR(limits("elbow_r").second, 150.0, 1e-9);
+  // hip abduction 45 / adduction 30 about +x on the left, mirrored to −x on the right
+  EXPECT_NEAR(limits("hip_l.x").first, -30.0, 1e-9);
+  EXPECT_NEAR(limits("hip_l.x").second, 45.0, 1e-9);
+  EXPECT_NEAR(limits("hip_r.x").first, -45.0, 1e-9);
+  EXPECT_NEAR(limits("hip_r.x").second, 30.0, 1e-9);
+  EXPECT_NEAR(limits("hip_r.y").first, -120.0, 1e-9);  // flexion is about −y on both sides
+  // the anatomical posture is within every limit
+  const VectorX q = m.neutralConfiguration();
+  EXPECT_TRUE(((q - m.lower_limit).array() >= 0).all());
+  EXPECT_TRUE(((m.upper_limit - q).array() >= 0).all());
+}
+
+TEST(Anthropometry, PositiveAnglesMoveLimbsTheAnatomicalWay) {
+  Built b(MannequinSpec{});
+  const auto names = b.m.coordinateNames();
+  const auto idx = [&](const std::string& c) { return static_cast<int>(std::find(names.begin(), names.end(), c) - names.begin()); };
+  VectorX q = b.m.neutralConfiguration();
+  b.at(q);
+  const Vector3 ankle0 = b.joint("ankle_l"), wrist0_l = b.joint("wrist_l"), elbow0_r = b.joint("elbow_r"),
+                knee0 = b.joint("knee_r");
+  q(idx("knee_l")) = 90 * kDeg;         // knee flexion: the ankle goes backward
+  q(idx("elbow_l")) = 90 * kDeg;        // elbow flexion: the wrist comes forward
+  q(idx("shoulder_r.x")) = -90 * kDeg;  // right shoulder abduction (mirrored sign): elbow goes to the right
+  q(idx("hip_r.y")) = -90 * kDeg;       // hip flexion: the knee comes forward
+  b.at(q);
+  EXPECT_LT(b.joint("ankle_l").x(), ankle0.x() - 0.3);
+  EXPECT_GT(b.joint("wrist_l").x(), wrist0_l.x() + 0.2);
+  EXPECT_LT(b.joint("elbow_r").y(), elbow0_r.y() - 0.2);
+  EXPECT_GT(b.joint("knee_r").x(), knee0.x() + 0.3);
+}
+
+TEST(Anthropometry, BadConfigsNameFileLineAndKey) {
+  EXPECT_NE(configError("sex: male\nstature_m: 1.8\nmass_kg: 80\nheight: 2\n").find("test.yaml:4: unknown key 'height'"),
+            std::string::npos);
+  EXPECT_NE(configError("sex: male\nstature_m: 18\nmass_kg: 80\n").find("test.yaml:2: 'stature_m' = 18 is outside"),
+            std::string::npos);
+  EXPECT_NE(configError("sex: male\nstature_m: 1.8\nmass_kg: heavy\n").find("test.yaml:3: 'mass_kg' must be a number"),
+            std::string::npos);
+  EXPECT_NE(configError("sex: male\nstature_m: .nan\nmass_kg: 80\n").find("finite"), std::string::npos);
+  EXPECT_NE(configError("sex: robot\nstature_m: 1.8\nmass_kg: 80\n").find("'sex' must be 'male' or 'female'"),
+            std::string::npos);
+  EXPECT_NE(configError("stature_m: 1.8\nmass_kg: 80\n").find("missing key 'sex'"), std::string::npos);
+  EXPECT_NE(configError("sex: male\nstature_m: 1.8\nmass_kg: 80\njoint_limits_deg:\n  kneee_l: [0, 90]\n")
+                .find("unknown coordinate 'kneee_l'"),
+            std::string::npos);
+  EXPECT_NE(configError("sex: male\nstature_m: 1.8\nmass_kg: 80\njoint_limits_deg:\n  knee_l: [90, 0]\n").find("min > max"),
+            std::string::npos);
+  EXPECT_NE(configError("sex: [male\n").find("invalid YAML"), std::string::npos);
+  EXPECT_NE(configError("- a\n- b\n").find("expected a mapping"), std::string::npos);
+  EXPECT_THROW(loadMannequinSpec("/nonexistent/mannequin.yaml"), ConfigError);
+  // an override is applied
+  const MannequinSpec s = parseMannequinSpec("sex: female\nstature_m: 1.6\nmass_kg: 55\njoint_limits_deg:\n  knee_l: [0, 90]\n", "t");
+  const Model m = buildMannequin(s);
+  EXPECT_NEAR(m.upper_limit(m.joints[m.jointIndex("knee_l")].idx_q), 90 * kDeg, 1e-12);
+  // the API rejects absurd values too
+  MannequinSpec bad;
+  bad.mass = std::nan("");
+  EXPECT_THROW(buildMannequin(bad), std::invalid_argument);
+}
