@@ -47,6 +47,7 @@ std::string jsonString(const std::string& s) {
 /// A JSON number with 9 significant digits (null if not finite).
 std::string num(double v) {
   if (!std::isfinite(v)) return "null";
+  if (v == 0.0) v = 0.0;  // no "-0"
   char buf[32];
   std::snprintf(buf, sizeof buf, "%.9g", v);
   return buf;
