@@ -423,12 +423,25 @@ Bvh parseBvh(std::string_view text, const std::string& source, const BvhReadOpti
 }
 
 Bvh readBvhFile(const std::string& path, const BvhReadOptions& options) {
-  std::ifstream in(path, std::ios::binary);
+  std::ifstream in(path, std::ios::binary | std::ios::ate);
   if (!in) throw BvhError(path, 0, "cannot open file");
-  std::ostringstream buffer;
-  buffer << in.rdbuf();
-  if (in.bad()) throw BvhError(path, 0, "cannot read file");
-  return parseBvh(buffer.str(), path, options);
+  // one read of the whole file
+  const std::streamoff size = in.tellg();
+  std::string text;
+  if (size > 0) {
+    text.resize(static_cast<std::size_t>(size));
+    in.seekg(0);
+    in.read(text.data(), size);
+    if (in.gcount() != size) throw BvhError(path, 0, "cannot read file");
+  } else {
+    // not seekable (a pipe): read as a stream
+    in.clear();
+    in.seekg(0);
+    std::ostringstream buffer;
+    buffer << in.rdbuf();
+    text = buffer.str();
+  }
+  return parseBvh(text, path, options);
 }
 
 int bvhJointCount(const Bvh& bvh) {
@@ -473,6 +486,23 @@ math::Matrix3 bvhAxisRotation(int axis, double angle_deg) {
   return R;
 }
 
+namespace {
+
+/// R ← R · R_axis(angle_deg), touching only the two columns the elementary rotation mixes.
+void rotateColumns(math::Matrix3& R, int axis, double angle_deg) {
+  double s = 0.0;
+  double c = 1.0;
+  sinCosDeg(angle_deg, s, c);
+  const int i = (axis + 1) % 3;
+  const int j = (axis + 2) % 3;
+  const math::Vector3 ci = R.col(i);
+  const math::Vector3 cj = R.col(j);
+  R.col(i) = c * ci + s * cj;
+  R.col(j) = c * cj - s * ci;
+}
+
+}  // namespace
+
 math::SE3 bvhLocalPose(const Bvh& bvh, int joint, std::span<const double> frame, double length_scale) {
   const BvhJoint& j = bvh.joints[static_cast<std::size_t>(joint)];
   math::SE3 pose;
@@ -484,9 +514,9 @@ math::SE3 bvhLocalPose(const Bvh& bvh, int joint, std::span<const double> frame,
       case BvhChannel::Xposition: t.x() += v; break;
       case BvhChannel::Yposition: t.y() += v; break;
       case BvhChannel::Zposition: t.z() += v; break;
-      case BvhChannel::Xrotation: pose.R = pose.R * bvhAxisRotation(0, v); break;
-      case BvhChannel::Yrotation: pose.R = pose.R * bvhAxisRotation(1, v); break;
-      case BvhChannel::Zrotation: pose.R = pose.R * bvhAxisRotation(2, v); break;
+      case BvhChannel::Xrotation: rotateColumns(pose.R, 0, v); break;
+      case BvhChannel::Yrotation: rotateColumns(pose.R, 1, v); break;
+      case BvhChannel::Zrotation: rotateColumns(pose.R, 2, v); break;
     }
   }
   pose.p = t * length_scale;
