@@ -1,0 +1,71 @@
+#pragma once
+/// \file lemke.hpp
+/// \brief Lemke's complementary pivoting (thesis 3.1.2, Algorithm 4) with the
+/// lexicographic ratio test, so degenerate problems do not cycle.
+///
+/// Works on w − M z − d z₀ = q. The tableau only stores the n+1 non-basic columns
+/// (n×(n+1), dense, column-major) and is updated in place by a rank-one exchange at each
+/// pivot; nothing is allocated once the workspace has the right size. For a copositive-plus
+/// M (e.g. symmetric positive semidefinite) ray termination proves the LCP has no solution.
+#include <vector>
+
+#include "mannequin/lcp/lcp.hpp"
+
+namespace mannequin::lcp {
+
+/// Options of solveLemke.
+struct LemkeOptions {
+  /// Maximum number of pivots; 0 means 100·n + 1000.
+  int max_pivots = 0;
+  /// A column entry t may be a pivot only if t > pivot_tolerance · max(‖column‖∞, scale),
+  /// scale being max(‖M‖max, ‖d‖∞).
+  double pivot_tolerance = 1e-12;
+  /// Relative tolerance under which two ratios count as tied (lexicographic rule).
+  double tie_tolerance = 1e-12;
+  /// Covering vector d (n entries, all > 0). Empty means d = 1.
+  Eigen::VectorXd covering;
+  /// Extra runs with a perturbed covering vector when a run ends on a ray or fails the
+  /// residual check (rank-deficient M can make a path numerically unstable). A genuine
+  /// ray termination is still reported as NoSolution.
+  int retries = 3;
+  /// A ray met after a pivot with |pivot| < unreliable_pivot · ‖column‖∞ is reported as
+  /// NumericalFailure rather than NoSolution.
+  double unreliable_pivot = 1e-9;
+  /// Iterative-refinement steps applied to the final basic solution.
+  int refinement_steps = 2;
+  /// A final answer is reported Solved only if both relative residuals are ≤ this.
+  double check_tolerance = 1e-9;
+};
+
+/// Pre-sized storage for solveLemke. Resized (and allocated) only when n changes.
+class LemkeWorkspace {
+ public:
+  LemkeWorkspace() = default;
+  explicit LemkeWorkspace(Index n) { resize(n); }
+  /// Allocates for problems of size n.
+  void resize(Index n);
+  Index size() const { return n_; }
+
+  // internal state, public so the solver is a free function (do not modify)
+  Index n_ = -1;
+  Eigen::MatrixXd tableau_;  // n×(n+1), B⁻¹ times the non-basic columns of [I, −M, −d]
+  Eigen::VectorXd rhs_;      // n, B⁻¹ q: values of the basic variables
+  Eigen::VectorXd col_;      // n, pivot column copy
+  Eigen::VectorXd row_;      // n+1, pivot row copy
+  Eigen::VectorXd cover_;    // n, covering vector
+  Eigen::VectorXd resid_;    // n, refinement residual
+  Eigen::VectorXd delta_;    // n, refinement correction
+  std::vector<int> basic_;     // n, variable basic in each row
+  std::vector<int> nonbasic_;  // n+1, variable in each tableau column
+  std::vector<int> where_;     // 2n+1, row (≥ 0) or −(column+1) of each variable
+  std::vector<int> ties_;      // candidate rows of the ratio test
+  std::vector<int> keep_;      // scratch for the lexicographic filter
+};
+
+/// Solves 0 ≤ M z + q ⊥ z ≥ 0 (M n×n, q n) by Lemke's method.
+/// Returns Solved, NoSolution (ray termination), PivotLimit, Invalid (bad sizes, NaN/Inf,
+/// non-positive covering vector) or NumericalFailure (final residual check failed).
+LcpResult solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace,
+                     const LemkeOptions& options = {});
+
+}  // namespace mannequin::lcp
