@@ -9,7 +9,7 @@
 
 #include "mannequin/lcp/lcp.hpp"
 
-namespace mannequin::lcp::testing {
+namespace mannequin::lcp::gen {
 
 /// Uniform random matrix in [lo, hi] (rows×cols), reproducible from seed.
 inline Eigen::MatrixXd uniform(Index rows, Index cols, double lo, double hi, std::mt19937& rng) {
@@ -135,4 +135,4 @@ inline ContactLike makeContactLike(Index n, std::uint32_t seed, double regulariz
   return c;
 }
 
-}  // namespace mannequin::lcp::testing
+}  // namespace mannequin::lcp::gen
