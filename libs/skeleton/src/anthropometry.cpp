@@ -1,11 +1,9 @@
 #include "mannequin/skeleton/anthropometry.hpp"
 
-#include <yaml-cpp/yaml.h>
+#include "config_util.hpp"
 
 #include <cmath>
-#include <fstream>
 #include <set>
-#include <sstream>
 
 #include "mannequin/skeleton/kinematics.hpp"
 
@@ -285,12 +283,7 @@ double readNumber(const std::string& source, const YAML::Node& node, const std::
 }  // namespace
 
 MannequinSpec parseMannequinSpec(const std::string& text, const std::string& source) {
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
-  }
+  const YAML::Node root = detail::parseYaml(text, source);
   if (!root.IsMap()) throw ConfigError(source + ":1: expected a mapping of keys (name, sex, stature_m, mass_kg, ...)");
 
   static const std::set<std::string> kKeys = {"name", "sex", "stature_m", "mass_kg", "toes", "density_kg_m3",
@@ -359,11 +352,7 @@ MannequinSpec parseMannequinSpec(const std::string& text, const std::string& sou
 }
 
 MannequinSpec loadMannequinSpec(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path + ":0: cannot open mannequin config");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseMannequinSpec(ss.str(), path);
+  return parseMannequinSpec(detail::readConfigFile(path, "mannequin config"), path);
 }
 
 }  // namespace mannequin::skeleton

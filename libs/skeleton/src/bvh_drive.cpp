@@ -1,10 +1,8 @@
 #include "mannequin/skeleton/bvh_drive.hpp"
 
-#include <yaml-cpp/yaml.h>
+#include "config_util.hpp"
 
 #include <cmath>
-#include <fstream>
-#include <sstream>
 
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
@@ -49,12 +47,7 @@ BvhDriveMap parseBvhDriveMap(const std::string& text, const std::string& source)
   const auto fail = [&](const YAML::Node& n, const std::string& msg) -> void {
     throw ConfigError(source + ":" + std::to_string(n.IsDefined() ? n.Mark().line + 1 : 1) + ": " + msg);
   };
-  YAML::Node root;
-  try {
-    root = YAML::Load(text);
-  } catch (const YAML::Exception& e) {
-    throw ConfigError(source + ":" + std::to_string(e.mark.line + 1) + ": invalid YAML: " + e.msg);
-  }
+  const YAML::Node root = detail::parseYaml(text, source);
   if (!root.IsMap()) throw ConfigError(source + ":1: expected a mapping with keys name, unit, segments");
   BvhDriveMap map;
   for (const auto& kv : root) {
@@ -93,11 +86,7 @@ BvhDriveMap parseBvhDriveMap(const std::string& text, const std::string& source)
 }
 
 BvhDriveMap loadBvhDriveMap(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw ConfigError(path + ":0: cannot open mapping config");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseBvhDriveMap(ss.str(), path);
+  return parseBvhDriveMap(detail::readConfigFile(path, "mapping config"), path);
 }
 
 // ---- calibration --------------------------------------------------------------------------
