@@ -194,3 +194,12 @@ TEST(Lemke, ContactLike) {
     }
   }
 }
+
+// larger contact-like problems (n = 300 > 42 DoF, rank-deficient): solved exactly
+TEST(Lemke, ContactLikeLarge) {
+  LemkeWorkspace ws;
+  for (std::uint32_t seed = 1; seed <= 8; ++seed) {
+    const auto c = gen::makeContactLike(300, seed);
+    expectSolved(solveLemke(c.lcp, ws));
+  }
+}

@@ -225,16 +225,22 @@ LcpResult solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace,
     workspace.cover_.setOnes();
   }
   res = lemkeAttempt(problem, workspace, options);
-  // on rank-deficient M a near-singular basis can derail the path: retry along another
-  // path (perturbed covering vector); a real ray comes back again and is reported
+  // on rank-deficient M a near-singular basis can derail the path: retry with another
+  // tolerance or along another path; a real ray comes back again and is reported
   int total = res.pivots;
   for (int k = 1; k <= options.retries && (res.status == LcpStatus::NoSolution ||
                                            res.status == LcpStatus::NumericalFailure); ++k) {
-    for (Index i = 0; i < n; ++i) {
-      const double frac = std::fmod(0.6180339887498949 * static_cast<double>((i + 1) * (k + 1)), 1.0);
-      workspace.cover_[i] = (options.covering.size() == n ? options.covering[i] : 1.0) * (0.5 + frac);
+    // odd retries: another pivot tolerance on the same path; even ones: another path
+    LemkeOptions alt = options;
+    if (k % 2 == 1) {
+      alt.pivot_tolerance = options.pivot_tolerance * (k == 1 ? 100.0 : 0.01);
+    } else {
+      for (Index i = 0; i < n; ++i) {
+        const double frac = std::fmod(0.6180339887498949 * static_cast<double>((i + 1) * (k + 1)), 1.0);
+        workspace.cover_[i] = (options.covering.size() == n ? options.covering[i] : 1.0) * (0.5 + frac);
+      }
     }
-    LcpResult retry = lemkeAttempt(problem, workspace, options);
+    LcpResult retry = lemkeAttempt(problem, workspace, alt);
     total += retry.pivots;
     if (retry.status == LcpStatus::Solved || retry.status == res.status) res = std::move(retry);
   }

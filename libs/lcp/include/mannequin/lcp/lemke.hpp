@@ -24,9 +24,10 @@ struct LemkeOptions {
   double tie_tolerance = 1e-12;
   /// Covering vector d (n entries, all > 0). Empty means d = 1.
   Eigen::VectorXd covering;
-  /// Extra runs with a perturbed covering vector when a run ends on a ray or fails the
-  /// residual check (rank-deficient M can make a path numerically unstable). A genuine
-  /// ray termination is still reported as NoSolution.
+  /// Extra runs when a run ends on a ray or fails the residual check (rank-deficient M can
+  /// make a path numerically unstable): odd retries change the pivot tolerance (×100, then
+  /// ×0.01), even ones perturb the covering vector (another path). A genuine ray
+  /// termination is still reported as NoSolution.
   int retries = 3;
   /// A ray met after a pivot with |pivot| < unreliable_pivot · ‖column‖∞ is reported as
   /// NumericalFailure rather than NoSolution.
