@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <random>
 #include <string>
 
 #include "mannequin/lcp/lemke.hpp"
@@ -86,6 +87,25 @@ void ourStructured(benchmark::State& st, bool contact) {
   record(st, r);
 }
 
+// consecutive time steps: q alternates between two nearby vectors (distances grown by up
+// to 1 mm, so both stay feasible) and each solve is warm-started from the previous active set
+void ourStructuredWarm(benchmark::State& st, bool contact) {
+  const Case c = makeCase(contact, st.range(0));
+  std::mt19937 rng(7);
+  const Eigen::VectorXd q2 = c.lcp.q + gen::uniform(c.lcp.q.size(), 1, 0.0, 1e-3, rng);
+  StructuredWorkspace ws;
+  LcpResult r;
+  bool flip = false;
+  for (auto _ : st) {
+    flip = !flip;
+    benchmark::DoNotOptimize(r = solveStructured(StructuredProblem{c.A, flip ? q2 : c.lcp.q}, ws));
+  }
+  const Eigen::VectorXd& q = flip ? q2 : c.lcp.q;
+  r.w = c.lcp.M * r.z + q;
+  r.residuals = computeResiduals(q, r.z, r.w);
+  record(st, r);
+}
+
 #ifdef MANNEQUIN_HAVE_SICONOS
 void siconos(benchmark::State& st, bool contact, int solver) {
   const Index n = st.range(0);
@@ -131,6 +151,9 @@ void registerAll() {
       benchmark::RegisterBenchmark(("lemke/" + kind).c_str(), ourLemke, contact)->Arg(n)->Unit(unit)->MinTime(0.2);
       benchmark::RegisterBenchmark(("pgs/" + kind).c_str(), ourPgs, contact)->Arg(n)->Unit(unit)->MinTime(0.2);
       benchmark::RegisterBenchmark(("structured/" + kind).c_str(), ourStructured, contact)->Arg(n)->Unit(unit)->MinTime(0.2);
+      if (contact) {
+        benchmark::RegisterBenchmark("structured_warm/contact", ourStructuredWarm, contact)->Arg(n)->Unit(unit)->MinTime(0.2);
+      }
 #ifdef MANNEQUIN_HAVE_SICONOS
       // Siconos' dense Lemke grows like n³ per solve: capped at n = 500 (≈ seconds per run)
       if (n <= 500) {
