@@ -1,0 +1,97 @@
+// Allocation counting: the solve path allocates a fixed number of blocks per call (result
+// vectors), never per pivot / sweep / active-set step. malloc is interposed, so this runs
+// only without AddressSanitizer (which owns malloc).
+#include <gtest/gtest.h>
+
+#include <cstddef>
+
+#include "mannequin/lcp/lemke.hpp"
+#include "mannequin/lcp/pgs.hpp"
+#include "mannequin/lcp/structured.hpp"
+#include "mannequin/lcp/testing.hpp"
+
+#if !defined(__SANITIZE_ADDRESS__)
+namespace {
+long g_allocations = 0;
+bool g_counting = false;
+}  // namespace
+extern "C" void* __libc_malloc(std::size_t size);
+extern "C" void* malloc(std::size_t size) {
+  if (g_counting) ++g_allocations;
+  return __libc_malloc(size);
+}
+#endif
+
+using namespace mannequin::lcp;
+
+namespace {
+
+template <class F>
+long countAllocations(F&& f) {
+#if !defined(__SANITIZE_ADDRESS__)
+  g_allocations = 0;
+  g_counting = true;
+  f();
+  g_counting = false;
+  return g_allocations;
+#else
+  f();
+  return -1;
+#endif
+}
+
+}  // namespace
+
+TEST(Allocation, LemkeDoesNotAllocatePerPivot) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "malloc is owned by AddressSanitizer";
+#endif
+  const Index n = 60;
+  const LcpProblem many = gen::makeSpd(n, 3);
+  LcpProblem few = many;
+  few.q.setOnes();
+  few.q[0] = -1.0;
+  LemkeWorkspace ws(n);
+  LcpResult a, b;
+  const long na = countAllocations([&] { a = solveLemke(few, ws); });
+  const long nb = countAllocations([&] { b = solveLemke(many, ws); });
+  ASSERT_EQ(a.status, LcpStatus::Solved);
+  ASSERT_EQ(b.status, LcpStatus::Solved);
+  EXPECT_LE(a.pivots, 2);
+  EXPECT_GE(b.pivots, 20);
+  EXPECT_GT(na, 0);  // the counter sees the result vectors, so it is live
+  EXPECT_EQ(na, nb);
+}
+
+TEST(Allocation, PgsAndStructuredDoNotAllocatePerStep) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "malloc is owned by AddressSanitizer";
+#endif
+  const auto c = gen::makeContactLike(120, 5);
+  LcpProblem few = c.lcp;
+  few.q.setConstant(0.01);
+  few.q[3] = -0.01;
+  StructuredWorkspace sw(120, c.A.cols());
+  StructuredOptions so;
+  so.warm_start = false;
+  LcpResult a, b;
+  const long na = countAllocations([&] { a = solveStructured(StructuredProblem{c.A, few.q}, sw, so); });
+  const long nb = countAllocations([&] { b = solveStructured(StructuredProblem{c.A, c.lcp.q}, sw, so); });
+  ASSERT_EQ(a.status, LcpStatus::Solved);
+  ASSERT_EQ(b.status, LcpStatus::Solved);
+  EXPECT_LT(a.pivots, b.pivots);
+  EXPECT_EQ(na, nb);
+  // PGS: 3 sweeps vs 30 sweeps
+  const auto spd = gen::makeSpd(50, 2);
+  PgsWorkspace pw(50);
+  PgsOptions o3, o30;
+  o3.max_iterations = 3;
+  o30.max_iterations = 30;
+  o30.tolerance = 0.0;
+  const long p3 = countAllocations([&] { a = solvePgs(spd, pw, o3); });
+  const long p30 = countAllocations([&] { b = solvePgs(spd, pw, o30); });
+  EXPECT_EQ(a.pivots, 3);
+  EXPECT_GE(b.pivots, 20);
+  EXPECT_GE(p30, p3);
+  EXPECT_LE(p30 - p3, 2);  // a converged sweep may build w once for its residual check
+}
