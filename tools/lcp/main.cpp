@@ -88,7 +88,13 @@ int main(int argc, char** argv) {
   solve->add_option("--solver", solver, "lemke | pgs | structured")
       ->check(CLI::IsMember({"lemke", "pgs", "structured"}));
   solve->add_flag("--json", json, "print one JSON object");
-  CLI11_PARSE(app, argc, argv);
+  // a bad command line exits with 2, like every mannequin tool (CLI11's own codes are > 100)
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? 0 : 2;
+  }
 
   // read and parse
   std::ifstream in(file);
