@@ -175,7 +175,6 @@ Model buildMannequin(const MannequinSpec& spec) {
   const int root = model.addJoint("root", JointType::kFreeFlyer, -1, SE3::Identity());
   {
     // the pelvis capsule lies across, between the hip joint centres
-    Segment s;
     b.segment("pelvis", root, T.lower_trunk, lpt, Vector3(0, 0, lpt), Vector3(0, 0, 0));
     Segment& pelvis = model.segments.back();
     const double w = kHipHalfWidth * H;

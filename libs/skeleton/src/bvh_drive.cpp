@@ -110,8 +110,12 @@ BvhDriver::BvhDriver(const Model& model, const Bvh& bvh, const BvhDriveMap& map)
     if (link_of_joint_[model.segments[s].joint] >= 0)
       throw std::invalid_argument("mapping '" + map.name + "': segment '" + seg_name + "' is mapped twice");
     link_of_joint_[model.segments[s].joint] = static_cast<int>(links_.size());
-    links_.push_back(Link{s, b, Matrix3::Identity(), Matrix3::Identity()});
+    links_.push_back(Link{s, b, Matrix3::Identity(), Matrix3::Identity(), {}});
   }
+  // the joints each mapped segment sets, found once
+  std::vector<char> carries(model.joints.size(), 0);
+  for (const Segment& seg : model.segments) carries[seg.joint] = 1;
+  for (Link& L : links_) L.chain = chainOf(model, L.segment, carries);
   if (model.segments[links_[0].segment].joint != 0 || model.joints[0].type != JointType::kFreeFlyer)
     throw std::invalid_argument("mapping '" + map.name + "': the first segment ('" + map.segments[0].first +
                                 "') must be carried by the free-flyer root");
@@ -181,8 +185,6 @@ BvhDriveFrame BvhDriver::drive(long long frame_index) {
 
   BvhDriveFrame out;
   out.q = model_.neutralConfiguration();
-  std::vector<char> carries(model_.joints.size(), 0);
-  for (const Segment& s : model_.segments) carries[s.joint] = 1;
   std::vector<Matrix3> oRi(model_.joints.size(), Matrix3::Identity());
 
   // walk the tree; each mapped segment sets the joints of its chain
@@ -191,7 +193,7 @@ BvhDriveFrame BvhDriver::drive(long long frame_index) {
     const int li = link_of_joint_[j];
     if (li >= 0) {
       const Link& L = links_[li];
-      const std::vector<int> chain = chainOf(model_, L.segment, carries);
+      const std::vector<int>& chain = L.chain;
       const int parent = model_.joints[chain.front()].parent;
       const Matrix3 R_parent = parent >= 0 ? oRi[parent] : Matrix3::Identity();
       const Matrix3 R_rel = (R_parent).transpose() * target[li];

@@ -63,6 +63,7 @@ class BvhDriver {
     int bvh;           // BVH joint
     math::Matrix3 C;   // rest calibration (mannequin world)
     math::Matrix3 rest_inv;  // R_b(rest)ᵀ
+    std::vector<int> chain;  // joints its orientation sets, root side first
   };
   const Model& model_;
   const Bvh& bvh_;
