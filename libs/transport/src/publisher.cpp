@@ -1,0 +1,108 @@
+#include "mannequin/transport/publisher.hpp"
+
+#include <spdlog/spdlog.h>
+
+#include <stdexcept>
+
+#include "mannequin/transport/clock.hpp"
+
+namespace mannequin::transport {
+
+std::string normalizeEndpoint(const std::string& endpoint) {
+  auto starts = [&](std::string_view p) { return endpoint.rfind(p, 0) == 0; };
+  if (starts("ipc://") || starts("inproc://")) {
+    const auto rest = endpoint.substr(endpoint.find("://") + 3);
+    if (rest.empty()) throw std::invalid_argument("endpoint '" + endpoint + "': empty path");
+    return endpoint;
+  }
+  if (starts("tcp://")) {
+    const auto colon = endpoint.rfind(':');
+    if (colon <= 5 || colon + 1 >= endpoint.size())
+      throw std::invalid_argument("endpoint '" + endpoint + "': expected tcp://HOST:PORT");
+    const std::string port = endpoint.substr(colon + 1);
+    if (port == "0") return endpoint.substr(0, colon + 1) + "*";
+    if (port == "*") return endpoint;
+    for (char c : port)
+      if (c < '0' || c > '9') throw std::invalid_argument("endpoint '" + endpoint + "': port '" + port + "' is not a number");
+    if (std::stol(port) > 65535) throw std::invalid_argument("endpoint '" + endpoint + "': port out of range");
+    return endpoint;
+  }
+  throw std::invalid_argument("endpoint '" + endpoint + "': expected tcp://HOST:PORT, ipc://PATH or inproc://NAME");
+}
+
+Publisher::Publisher(zmq::context_t& context, PublisherOptions options)
+    : options_(std::move(options)), socket_(context, zmq::socket_type::xpub) {
+  if (options_.endpoints.empty()) throw std::invalid_argument("publisher '" + options_.source + "': no endpoint to bind");
+  socket_.set(zmq::sockopt::sndhwm, options_.send_hwm);
+  socket_.set(zmq::sockopt::linger, 0);
+  socket_.set(zmq::sockopt::xpub_verbose, 1);
+  for (const std::string& ep : options_.endpoints) {
+    const std::string normalized = normalizeEndpoint(ep);
+    try {
+      socket_.bind(normalized);
+    } catch (const zmq::error_t& e) {
+      throw std::runtime_error("publisher '" + options_.source + "': cannot bind '" + ep + "': " + e.what());
+    }
+    bound_.push_back(socket_.get(zmq::sockopt::last_endpoint));
+  }
+}
+
+Publisher::TopicState& Publisher::state(std::string_view topic) {
+  auto it = topics_.find(std::string(topic));
+  if (it != topics_.end()) return it->second;
+  TopicState s;
+  s.counters.topic = std::string(topic);
+  const topics::TopicInfo* info = topics::find(topic);
+  s.latched = info != nullptr && info->delivery == Delivery::kLatest;
+  return topics_.emplace(std::string(topic), std::move(s)).first->second;
+}
+
+void Publisher::fillHeader(std::string_view topic, v1::Header& header) {
+  TopicState& s = state(topic);
+  header.set_schema_version(kSchemaVersion);
+  header.set_sequence(++s.sequence);
+  header.set_source(options_.source);
+  header.set_send_time_ns(options_.deterministic ? 0 : wallNs());
+}
+
+void Publisher::send(std::string_view topic, std::string_view payload) {
+  (void)socket_.send(zmq::buffer(topic), zmq::send_flags::sndmore | zmq::send_flags::dontwait);
+  (void)socket_.send(zmq::buffer(payload), zmq::send_flags::dontwait);
+}
+
+void Publisher::publishRaw(std::string_view topic, std::string_view payload) {
+  poll();
+  TopicState& s = state(topic);
+  send(topic, payload);
+  ++s.counters.delivered;
+  if (s.latched) {
+    s.last.assign(payload.data(), payload.size());
+    s.has_last = true;
+  }
+}
+
+int Publisher::poll() {
+  int n = 0;
+  zmq::message_t msg;
+  while (socket_.recv(msg, zmq::recv_flags::dontwait)) {
+    ++n;
+    const auto* data = static_cast<const char*>(msg.data());
+    if (msg.size() < 1 || data[0] != 1) continue;  // unsubscribe (0) or garbage
+    ++subscriptions_;
+    const std::string_view prefix(data + 1, msg.size() - 1);
+    for (auto& [name, s] : topics_) {
+      if (!s.latched || !s.has_last || name.compare(0, prefix.size(), prefix) != 0) continue;
+      send(name, s.last);
+      ++s.counters.resent;
+    }
+  }
+  return n;
+}
+
+std::vector<TopicCounters> Publisher::counters() const {
+  std::vector<TopicCounters> out;
+  for (const auto& [name, s] : topics_) out.push_back(s.counters);
+  return out;
+}
+
+}  // namespace mannequin::transport
