@@ -1,0 +1,54 @@
+#pragma once
+/// \file synthetic_source.hpp
+/// \brief Scripted trajectories for tests: each body moves as p(t) = center + amplitude ∘ sin(2π f t + phase)
+/// (component-wise) with a constant orientation, or rotates about z at `yaw_rate`; bodies can be occluded
+/// over time windows.
+#include <string>
+#include <vector>
+
+#include "mannequin/mocap/source.hpp"
+
+namespace mannequin::mocap {
+
+struct SyntheticBody {
+  std::string name;
+  math::Vector3 center = math::Vector3::Zero();     ///< m, room frame
+  math::Vector3 amplitude = math::Vector3::Zero();  ///< m
+  double frequency = 0.0;                           ///< Hz
+  double phase = 0.0;                               ///< rad
+  math::Matrix3 orientation = math::Matrix3::Identity();
+  double yaw_rate = 0.0;                            ///< rad/s about the room z axis
+};
+
+struct Occlusion {
+  std::string body;
+  double from = 0.0, to = 0.0;  ///< capture time window [from, to) in s
+};
+
+struct SyntheticOptions {
+  double rate_hz = 120.0;
+  double duration = 0.0;  ///< s of capture, 0 = endless
+  bool paced = true;
+  std::vector<SyntheticBody> bodies;
+  std::vector<Occlusion> occlusions;
+};
+
+class SyntheticSource final : public Source {
+ public:
+  /// \throws std::invalid_argument for a rate <= 0 or no bodies.
+  explicit SyntheticSource(SyntheticOptions options);
+  std::optional<Sample> next(std::chrono::microseconds timeout) override;
+  bool finished() const override { return finished_; }
+  std::string kind() const override { return "synthetic"; }
+  std::string describe() const override;
+  /// The sample at frame k (time k / rate_hz).
+  Sample sampleAt(std::uint64_t k) const;
+
+ private:
+  SyntheticOptions options_;
+  std::uint64_t k_ = 0;
+  bool started_ = false, finished_ = false;
+  std::int64_t start_ns_ = 0;
+};
+
+}  // namespace mannequin::mocap

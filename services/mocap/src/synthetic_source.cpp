@@ -1,0 +1,67 @@
+#include "mannequin/mocap/synthetic_source.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+
+#include "mannequin/math/so3.hpp"
+#include "mannequin/transport/clock.hpp"
+
+namespace mannequin::mocap {
+
+SyntheticSource::SyntheticSource(SyntheticOptions options) : options_(std::move(options)) {
+  if (!(options_.rate_hz > 0)) throw std::invalid_argument("synthetic: rate_hz must be > 0");
+  if (options_.bodies.empty()) throw std::invalid_argument("synthetic: no bodies");
+  for (const Occlusion& o : options_.occlusions) {
+    bool known = false;
+    for (const auto& b : options_.bodies) known = known || b.name == o.body;
+    if (!known) throw std::invalid_argument("synthetic: occlusion of unknown body '" + o.body + "'");
+  }
+}
+
+std::string SyntheticSource::describe() const {
+  return fmt::format("synthetic trajectories ({} bodies at {} Hz{})", options_.bodies.size(), options_.rate_hz,
+                     options_.duration > 0 ? fmt::format(" for {} s", options_.duration) : std::string());
+}
+
+Sample SyntheticSource::sampleAt(std::uint64_t k) const {
+  const double t = static_cast<double>(k) / options_.rate_hz;
+  Sample s;
+  s.frame_number = k;
+  s.stamp_ns = static_cast<std::int64_t>(std::llround(t * 1e9));
+  s.calibration_pose = k == 0;
+  for (std::size_t i = 0; i < options_.bodies.size(); ++i) {
+    const SyntheticBody& sb = options_.bodies[i];
+    Body b;
+    b.name = sb.name;
+    b.id = static_cast<int>(i);
+    const double w = 2 * M_PI * sb.frequency * t + sb.phase;
+    b.pose.p = sb.center + sb.amplitude * std::sin(w);
+    b.pose.R = math::expSO3(math::Vector3(0, 0, sb.yaw_rate * t)) * sb.orientation;
+    for (const Occlusion& o : options_.occlusions)
+      if (o.body == sb.name && t >= o.from && t < o.to) b.tracked = false;
+    if (!b.tracked) b.quality = 0.0;
+    s.bodies.push_back(b);
+  }
+  return s;
+}
+
+std::optional<Sample> SyntheticSource::next(std::chrono::microseconds timeout) {
+  if (finished_) return std::nullopt;
+  if (options_.duration > 0 && static_cast<double>(k_) / options_.rate_hz > options_.duration) {
+    finished_ = true;
+    return std::nullopt;
+  }
+  if (options_.paced) {
+    if (!started_) {
+      started_ = true;
+      start_ns_ = transport::steadyNs();
+    }
+    const auto due = start_ns_ + static_cast<std::int64_t>(static_cast<double>(k_) / options_.rate_hz * 1e9);
+    if (!sleepUntil(due, timeout)) return std::nullopt;
+  }
+  return sampleAt(k_++);
+}
+
+}  // namespace mannequin::mocap
