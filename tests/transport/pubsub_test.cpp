@@ -2,6 +2,7 @@
 // late joiners, sequence gaps, slow subscribers.
 #include <gtest/gtest.h>
 
+#include <set>
 #include <thread>
 
 #include "mannequin/transport/clock.hpp"
@@ -236,4 +237,29 @@ TEST(PubSub, HeartbeatCarriesServiceCountersAndStats) {
   ASSERT_EQ(hb.stats_size(), 1);
   EXPECT_EQ(hb.stats(0).name(), "frames");
   EXPECT_EQ(hb.stats(0).value(), 3.0);
+}
+
+TEST(PubSub, LatestOnlyKeepsTheNewestOfEachSource) {
+  TempDir dir;
+  zmq::context_t ctx;
+  Publisher a(ctx, {"sim_a", {dir.ipc("a")}});
+  Publisher b(ctx, {"sim_b", {dir.ipc("b")}});
+  Subscriber sub(ctx, {"render", {dir.ipc("a"), dir.ipc("b")}});
+  std::vector<v1::WorldState> got;
+  sub.subscribe(topics::kSimWorld, collect(got));
+  ASSERT_TRUE(handshake(a, sub));
+  ASSERT_TRUE(handshake(b, sub));
+  for (int i = 1; i <= 5; ++i) {
+    v1::WorldState w;
+    w.set_step(i);
+    a.publish(topics::kSimWorld, w);
+    w.set_step(100 + i);
+    b.publish(topics::kSimWorld, w);
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  sub.poll(std::chrono::milliseconds(0));
+  ASSERT_EQ(got.size(), 2u);
+  std::set<std::uint64_t> steps{got[0].step(), got[1].step()};
+  EXPECT_EQ(steps, (std::set<std::uint64_t>{5, 105}));
+  EXPECT_EQ(sub.counters("sim.world").superseded, 8u);
 }

@@ -191,17 +191,20 @@ int Subscriber::poll(std::chrono::microseconds timeout) {
     if (entry.delivery == Delivery::kQueue) {
       dispatch(entry, *entry.prototype, received);
     } else {
-      if (entry.has_latest) ++entry.counters.superseded;
-      entry.latest.swap(entry.prototype);
-      entry.has_latest = true;
-      entry.latest_received = Received{it->first, now};
+      Entry::Pending& pending = entry.latest[headerOf(*entry.prototype)->source()];
+      if (pending.has) ++entry.counters.superseded;
+      if (!pending.message) pending.message.reset(entry.prototype->New());
+      pending.message.swap(entry.prototype);
+      pending.has = true;
+      pending.received = Received{it->first, now};
     }
   }
-  for (auto& [name, entry] : entries_) {
-    if (!entry->has_latest) continue;
-    entry->has_latest = false;
-    dispatch(*entry, *entry->latest, entry->latest_received);
-  }
+  for (auto& [name, entry] : entries_)
+    for (auto& [source, pending] : entry->latest) {
+      if (!pending.has) continue;
+      pending.has = false;
+      dispatch(*entry, *pending.message, pending.received);
+    }
   return delivered_in_poll_;
 }
 

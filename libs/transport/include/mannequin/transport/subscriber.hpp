@@ -5,8 +5,9 @@
 /// poll(timeout) waits up to `timeout` for traffic, then drains everything already queued (bounded),
 /// and calls the handlers:
 /// - kQueue topics: each valid message, in arrival order;
-/// - kLatest topics: only the newest valid message of the drain (the others count as superseded), so
-///   a subscriber slower than its publisher never works through a backlog of stale states.
+/// - kLatest topics: only the newest valid message of the drain from each source (Header.source; the
+///   others count as superseded), so a subscriber slower than its publishers never works through a
+///   backlog of stale states.
 /// Every frame is checked before its handler sees it: 2 parts, a subscribed topic, a payload that parses,
 /// a Header with schema_version == kSchemaVersion and a source, then the topic's validator if any.
 /// Anything else is counted (TopicCounters::malformed, unknownTopics()) and logged at most once per
@@ -61,7 +62,6 @@ class Subscriber {
     auto entry = std::make_unique<Entry>();
     entry->delivery = topic.delivery;
     entry->prototype = std::make_unique<M>();
-    entry->latest = std::make_unique<M>();
     entry->handler = [handler](const google::protobuf::Message& m, const Received& r) {
       handler(static_cast<const M&>(m), r);
     };
@@ -99,9 +99,12 @@ class Subscriber {
   struct Entry {
     Delivery delivery = Delivery::kQueue;
     std::unique_ptr<google::protobuf::Message> prototype;  // parse buffer
-    std::unique_ptr<google::protobuf::Message> latest;     // kLatest: newest valid message of this drain
-    bool has_latest = false;
-    Received latest_received;
+    struct Pending {
+      std::unique_ptr<google::protobuf::Message> message;  // kLatest: newest valid message of this drain
+      bool has = false;
+      Received received;
+    };
+    std::unordered_map<std::string, Pending> latest;  // per source
     std::function<void(const google::protobuf::Message&, const Received&)> handler;
     std::function<std::string(const google::protobuf::Message&)> validate;
     TopicCounters counters;

@@ -1,0 +1,73 @@
+#pragma once
+/// \file supervisor.hpp
+/// \brief Runs a deployment on this host: starts every service (fork/exec, own process group, killed
+/// with the launcher through PR_SET_PDEATHSIG), prefixes and forwards their output line by line,
+/// follows their heartbeats, restarts a crashed service with exponential backoff, and stops everything
+/// (SIGTERM in reverse start order, SIGKILL after the stop timeout, every child reaped).
+#include <sys/types.h>
+
+#include <atomic>
+#include <cstdint>
+#include <cstdio>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <mannequin/v1/health.pb.h>
+
+#include "mannequin/deploy/deployment.hpp"
+
+namespace mannequin::deploy {
+
+enum class ServiceState { kStarting, kUp, kLate, kBackoff, kFinished, kFailed, kStopped };
+const char* toString(ServiceState s);
+
+struct ServiceStatus {
+  std::string name;
+  ServiceState state = ServiceState::kStarting;
+  pid_t pid = -1;
+  std::vector<pid_t> pids;        ///< every pid it ran as
+  int starts = 0;
+  int restarts = 0;
+  std::string last_exit;          ///< "exit 0", "signal 11", "" while running
+  bool clean_exit = true;         ///< every exit was 0 or the SIGTERM of the shutdown
+  bool has_heartbeat = false;
+  std::int64_t last_heartbeat_ns = 0;  ///< steady clock
+  std::uint64_t heartbeats = 0;
+  v1::Heartbeat heartbeat;        ///< the last one
+};
+
+struct SupervisorOptions {
+  std::string exec_dir;            ///< where to look for executables first (the launcher's directory)
+  std::FILE* out = stdout;         ///< prefixed service output, status lines, summary
+  bool tty = false;                ///< redraw one live status line instead of printing status lines
+  double status_period = 5.0;      ///< s between status lines (tty: redraw period is 0.25 s)
+  double duration = 0.0;           ///< stop by itself after this many seconds (0 = until stop)
+};
+
+class Supervisor {
+ public:
+  Supervisor(Deployment deployment, SupervisorOptions options);
+  ~Supervisor();
+  /// Runs until `stop` becomes true (SIGINT/SIGTERM) or the duration elapses, then stops everything.
+  /// Returns 0 when every service ran and stopped cleanly, 1 if one failed permanently or exited badly.
+  int run(const std::atomic<bool>& stop);
+  const std::vector<ServiceStatus>& status() const { return status_; }
+  /// "3/3 up | mocap 120 Hz | sim 1000 Hz, world 60.0 Hz, late 0.2 ms | ..."
+  std::string statusLine() const;
+  /// Multi-line summary printed at the end.
+  std::string summary() const;
+  /// The same as JSON.
+  std::string summaryJson() const;
+  /// Resolved executable of a service (exec_dir, then PATH; a name with '/' is used as is).
+  std::string resolveExec(const std::string& exec) const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  Deployment deployment_;
+  SupervisorOptions options_;
+  std::vector<ServiceStatus> status_;
+};
+
+}  // namespace mannequin::deploy

@@ -1,0 +1,131 @@
+// The supervisor with real processes: start, heartbeats, prefixed output, restart with backoff,
+// permanent failure, clean stop, no process left behind.
+#include <gtest/gtest.h>
+#include <signal.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "mannequin/deploy/supervisor.hpp"
+
+using namespace mannequin::deploy;
+
+namespace {
+std::string runDir() {
+  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
+  return (std::filesystem::temp_directory_path() / ("mq-deploy-" + std::string(info->name()) + "-" + std::to_string(getpid())))
+      .string();
+}
+
+bool processGone(pid_t pid) { return kill(pid, 0) != 0 && errno == ESRCH; }
+}  // namespace
+
+TEST(Supervisor, RunsRestartsStopsAndLeavesNoProcess) {
+  const std::string dir = runDir();
+  const Deployment d = parseDeployment(R"(name: test
+heartbeat_timeout: 2
+stop_timeout: 3
+services:
+  - name: mocap
+    exec: mannequin-mocap
+    args: [--config, configs/sim/mocap_synthetic.yaml, --heartbeat-period, "0.1"]
+    publish: ipc://${RUN_DIR}/mocap
+  - name: broken
+    exec: mannequin-mocap
+    args: [--config, /nonexistent/config.yaml]
+    publish: ipc://${RUN_DIR}/broken
+    restart: {max_restarts: 2, backoff_initial: 0.05, backoff_max: 0.1}
+)",
+                                       "test.yaml", dir);
+  SupervisorOptions o;
+  o.exec_dir = MANNEQUIN_BIN_DIR;
+  o.duration = 1.5;
+  o.status_period = 0.5;
+  char* buffer = nullptr;
+  std::size_t size = 0;
+  std::FILE* out = open_memstream(&buffer, &size);
+  o.out = out;
+  Supervisor sup(d, o);
+  std::atomic<bool> stop{false};
+  const int rc = sup.run(stop);
+  std::fclose(out);
+  const std::string text(buffer, size);
+  free(buffer);
+
+  EXPECT_EQ(rc, 1) << text;  // 'broken' failed permanently
+  const auto& st = sup.status();
+  ASSERT_EQ(st.size(), 2u);
+  EXPECT_EQ(st[0].state, ServiceState::kStopped);
+  EXPECT_EQ(st[0].last_exit, "exit 0");
+  EXPECT_TRUE(st[0].clean_exit);
+  EXPECT_EQ(st[0].starts, 1);
+  EXPECT_GE(st[0].heartbeats, 5u);
+  ASSERT_TRUE(st[0].has_heartbeat);
+  EXPECT_EQ(st[0].heartbeat.service(), "mocap");
+  EXPECT_EQ(st[0].heartbeat.pid(), st[0].pids[0]);
+  EXPECT_EQ(st[1].state, ServiceState::kFailed);
+  EXPECT_EQ(st[1].starts, 3);  // first run + 2 restarts
+  EXPECT_EQ(st[1].restarts, 2);
+  EXPECT_EQ(st[1].last_exit, "exit 2");  // bad command line
+  // output is prefixed by the service name, status lines are printed
+  EXPECT_NE(text.find("mocap    | info mocap: synthetic trajectories"), std::string::npos) << text;
+  EXPECT_NE(text.find("broken   | --config: File does not exist"), std::string::npos) << text;
+  EXPECT_NE(text.find("status   | 1/2 up | mocap"), std::string::npos) << text;
+  EXPECT_NE(text.find("broken exited (exit 2) after 2 restarts: failed permanently"), std::string::npos) << text;
+  // no process left: all reaped (not zombies) and gone
+  for (const auto& s : st)
+    for (pid_t p : s.pids) {
+      EXPECT_TRUE(processGone(p)) << s.name << " pid " << p;
+      EXPECT_FALSE(std::filesystem::exists("/proc/" + std::to_string(p))) << p;
+    }
+  EXPECT_EQ(waitpid(-1, nullptr, WNOHANG), -1);  // no child of ours left at all
+  const std::string json = sup.summaryJson();
+  EXPECT_NE(json.find("\"name\": \"broken\", \"state\": \"failed\", \"starts\": 3"), std::string::npos) << json;
+  EXPECT_NE(sup.summary().find("pub mocap.frame"), std::string::npos);
+}
+
+TEST(Supervisor, StopFlagEndsTheRunAndCrashedServicesAreRestarted) {
+  const std::string dir = runDir();
+  // a service killed by a signal is restarted; the launcher's stop flag ends everything
+  const Deployment d = parseDeployment(R"(name: test2
+services:
+  - name: mocap
+    exec: mannequin-mocap
+    args: [--config, configs/sim/mocap_synthetic.yaml, --heartbeat-period, "0.1"]
+    publish: ipc://${RUN_DIR}/mocap
+    restart: {backoff_initial: 0.05}
+)",
+                                       "test2.yaml", dir);
+  SupervisorOptions o;
+  o.exec_dir = MANNEQUIN_BIN_DIR;
+  o.status_period = 0;
+  std::FILE* out = std::fopen("/dev/null", "w");
+  o.out = out;
+  Supervisor sup(d, o);
+  std::atomic<bool> stop{false};
+  std::thread killer([&] {
+    // wait for the first heartbeat, kill the service, wait for its second run, then stop
+    auto waitFor = [&](auto cond) {
+      for (int k = 0; k < 500 && !cond(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    };
+    waitFor([&] { return sup.status()[0].heartbeats > 0 && sup.status()[0].pid > 0; });
+    kill(sup.status()[0].pid, SIGKILL);
+    waitFor([&] { return sup.status()[0].starts == 2 && sup.status()[0].state == ServiceState::kUp; });
+    stop = true;
+  });
+  const int rc = sup.run(stop);
+  killer.join();
+  std::fclose(out);
+  const auto& st = sup.status()[0];
+  EXPECT_EQ(st.starts, 2);
+  EXPECT_EQ(st.restarts, 1);
+  EXPECT_FALSE(st.clean_exit);  // it was killed once
+  EXPECT_EQ(rc, 1);
+  EXPECT_EQ(st.state, ServiceState::kStopped);
+  EXPECT_EQ(st.last_exit, "exit 0");
+  for (pid_t p : st.pids) EXPECT_TRUE(processGone(p));
+}
