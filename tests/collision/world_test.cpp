@@ -1,0 +1,423 @@
+#include "mannequin/collision/world.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <random>
+#include <set>
+
+#include "mannequin/skeleton/anthropometry.hpp"
+#include "mannequin/skeleton/kinematics.hpp"
+#include "test_util.hpp"
+
+using namespace mannequin;
+using namespace mannequin::collision;
+using collision::test::worldA;
+using collision::test::worldB;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+SE3 at(const Vector3& p, const math::Matrix3& R = math::Matrix3::Identity()) { return SE3(R, p); }
+math::Matrix3 rotY(double a) { return rpy(0, a, 0); }
+
+World floorWorld(double activation = 1.0) {
+  WorldOptions o;
+  o.activation_distance = activation;
+  World w(o);
+  w.addBody("scene/floor", {{Shape::plane(Vector3::UnitZ(), 0.0), SE3()}}, SE3(), BodyKind::kStatic);
+  return w;
+}
+
+std::vector<Contact> between(const World& w, const ContactSet& cs, const std::string& a, const std::string& b) {
+  std::vector<Contact> out;
+  for (const auto& c : cs.contacts)
+    if (w.bodyName(c.body_a) == a && w.bodyName(c.body_b) == b) out.push_back(c);
+  return out;
+}
+
+// every contact: unit normal and distance == n·(pb − pa) in the world
+void expectConsistent(const World& w, const ContactSet& cs) {
+  for (const auto& c : cs.contacts) {
+    EXPECT_LT(c.body_a, c.body_b);
+    EXPECT_NEAR(c.normal.norm(), 1.0, 1e-12);
+    EXPECT_NEAR(c.distance, c.normal.dot(worldB(w, c) - worldA(w, c)), 1e-9)
+        << w.bodyName(c.body_a) << " / " << w.bodyName(c.body_b);
+  }
+}
+
+skeleton::Model mannequinModel(const char* name = "male_50th") {
+  return skeleton::buildMannequin(
+      skeleton::loadMannequinSpec(test::sourcePath(std::string("configs/mannequins/") + name + ".yaml")));
+}
+
+}  // namespace
+
+TEST(World, CapsuleUprightOnPlaneOnePoint) {
+  World w = floorWorld(0.3);  // the upper end (0.65 m up) is out of range
+  const int cap = w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}}, at({0.1, 0.2, 0.5}), BodyKind::kMovable);
+  ContactSet cs;
+  w.query(7, cs);
+  EXPECT_EQ(cs.step, 7u);
+  ASSERT_EQ(cs.contacts.size(), 1u);
+  const Contact& c = cs.contacts[0];
+  EXPECT_EQ(c.body_a, 0);
+  EXPECT_EQ(c.body_b, cap);
+  EXPECT_NEAR(c.distance, 0.5 - 0.2 - 0.05, 1e-14);
+  EXPECT_TRUE(c.normal.isApprox(Vector3::UnitZ()));
+  EXPECT_TRUE(c.point_a.isApprox(Vector3(0.1, 0.2, 0.0)));
+  EXPECT_TRUE(c.point_b.isApprox(Vector3(0, 0, -0.25)));
+}
+
+TEST(World, CapsuleLyingOnPlaneTwoPointsTiltedOne) {
+  World w = floorWorld();
+  const int cap = w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}}, at({0.3, 0, 0.08}, rotY(kPi / 2)),
+                            BodyKind::kMovable);
+  ContactSet cs;
+  w.query(0, cs);
+  ASSERT_EQ(cs.contacts.size(), 2u);
+  std::set<double> xs;
+  for (const auto& c : cs.contacts) {
+    EXPECT_NEAR(c.distance, 0.03, 1e-14);
+    EXPECT_TRUE(c.normal.isApprox(Vector3::UnitZ()));
+    EXPECT_NEAR(worldA(w, c).z(), 0.0, 1e-14);
+    EXPECT_NEAR(worldB(w, c).z(), 0.03, 1e-14);
+    xs.insert(std::round(worldB(w, c).x() * 1e9) / 1e9);
+  }
+  EXPECT_EQ(xs, (std::set<double>{0.1, 0.5}));
+  // tilted by 30° from the horizontal: only the lower end is in range (activation 2 cm)
+  w.setActivationDistance(0.02);
+  w.setBodyPose(cap, at({0.3, 0, 0.2 * std::sin(kPi / 6) + 0.05 + 0.01}, rotY(kPi / 2 - kPi / 6)));
+  w.query(1, cs);
+  ASSERT_EQ(cs.contacts.size(), 1u);
+  EXPECT_NEAR(cs.contacts[0].distance, 0.01, 1e-14);
+  expectConsistent(w, cs);
+}
+
+TEST(World, CapsuleBoxFaceEdgeAndPenetration) {
+  WorldOptions o;
+  o.activation_distance = 0.1;
+  World w(o);
+  w.addBody("box", {{Shape::box({1.0, 0.6, 0.2}), SE3()}}, SE3(), BodyKind::kStatic);
+  // lying along y on the top face, 4 cm above: the two ends
+  const int cap = w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}},
+                            at({0.2, 0, 0.1 + 0.05 + 0.04}, rpy(kPi / 2, 0, 0)), BodyKind::kMovable);
+  ContactSet cs;
+  w.query(0, cs);
+  ASSERT_EQ(cs.contacts.size(), 2u);
+  for (const auto& c : cs.contacts) {
+    EXPECT_NEAR(c.distance, 0.04, 1e-12);
+    EXPECT_TRUE(c.normal.isApprox(Vector3::UnitZ()));
+    EXPECT_NEAR(std::abs(c.point_a.y()), 0.2, 1e-12);
+    EXPECT_NEAR(c.point_a.x(), 0.2, 1e-12);
+    EXPECT_NEAR(c.point_a.z(), 0.1, 1e-12);
+  }
+  expectConsistent(w, cs);
+  // penetrating by 1 cm
+  w.setBodyPose(cap, at({0.2, 0, 0.1 + 0.05 - 0.01}, rpy(kPi / 2, 0, 0)));
+  w.query(1, cs);
+  ASSERT_EQ(cs.contacts.size(), 2u);
+  for (const auto& c : cs.contacts) EXPECT_NEAR(c.distance, -0.01, 1e-12);
+  expectConsistent(w, cs);
+  // upright beyond the edge x = 0.5: lower sphere centre at (0.53, 0, 0.14), radius 0.02
+  // → distance 0.05 − 0.02 = 0.03 to the edge point (0.5, 0, 0.1), normal (0.6, 0, 0.8)
+  w.setBodyPose(cap, at({5, 5, 5}));
+  const int thin = w.addBody("thin", {{Shape::capsule(0.02, 0.3), SE3()}}, at({0.53, 0, 0.14 + 0.15}),
+                             BodyKind::kMovable);
+  w.query(2, cs);
+  ASSERT_EQ(cs.contacts.size(), 1u);
+  const Contact& c = cs.contacts[0];
+  EXPECT_EQ(c.body_b, thin);
+  EXPECT_NEAR(c.distance, 0.03, 1e-10);
+  EXPECT_TRUE(c.normal.isApprox(Vector3(0.6, 0, 0.8), 1e-9));
+  EXPECT_TRUE(c.point_a.isApprox(Vector3(0.5, 0, 0.1), 1e-9));
+  EXPECT_TRUE(c.point_b.isApprox(Vector3(0, 0, -0.15) - 0.02 * Vector3(0.6, 0, 0.8), 1e-9));
+}
+
+TEST(World, SphereMeshFaceAndCorner) {
+  WorldOptions o;
+  o.activation_distance = 0.05;
+  World w(o);
+  auto mesh = std::make_shared<const TriangleMesh>(test::boxMesh(0.5));
+  const SE3 pose = at({1, 0, 0}, rpy(0, 0, kPi / 2));  // a quarter turn: same cube, other frame
+  const int m = w.addBody("mesh", {{Shape::fromMesh(mesh), SE3()}}, pose, BodyKind::kStatic);
+  const int ball = w.addBody("ball", {{Shape::sphere(0.1), SE3()}}, at({1.1, 0.05, 0.5 + 0.1 + 0.03}),
+                             BodyKind::kMovable);
+  ContactSet cs;
+  w.query(0, cs);
+  ASSERT_EQ(cs.contacts.size(), 1u);
+  const Contact& c = cs.contacts[0];
+  EXPECT_EQ(c.body_a, m);
+  EXPECT_EQ(c.body_b, ball);
+  EXPECT_NEAR(c.distance, 0.03, 1e-12);
+  EXPECT_TRUE(c.normal.isApprox(Vector3::UnitZ(), 1e-12));
+  EXPECT_TRUE(c.point_a.isApprox(pose.actInv(Vector3(1.1, 0.05, 0.5)), 1e-12));
+  EXPECT_TRUE(c.point_b.isApprox(Vector3(0, 0, -0.1), 1e-12));
+  EXPECT_GE(c.feature, 0);
+  EXPECT_LT(c.feature, 12);
+  // a small sphere near the corner (1.5, 0.5, 0.5) on the diagonal: d = √3·0.02 − 0.01
+  w.setBodyPose(ball, at({3, -3, 3}));
+  w.addBody("small", {{Shape::sphere(0.01), SE3()}}, at(Vector3(1.5, 0.5, 0.5) + 0.02 * Vector3(1, 1, 1)),
+            BodyKind::kMovable);
+  w.query(1, cs);
+  ASSERT_EQ(cs.contacts.size(), 1u);
+  EXPECT_NEAR(cs.contacts[0].distance, std::sqrt(3.0) * 0.02 - 0.01, 1e-12);
+  EXPECT_TRUE(cs.contacts[0].normal.isApprox(Vector3(1, 1, 1).normalized(), 1e-12));
+  EXPECT_TRUE(worldA(w, cs.contacts[0]).isApprox(Vector3(1.5, 0.5, 0.5), 1e-12));
+  expectConsistent(w, cs);
+}
+
+TEST(World, CapsuleLyingOnMeshTwoPoints) {
+  WorldOptions o;
+  o.activation_distance = 0.02;
+  World w(o);
+  auto mesh = std::make_shared<const TriangleMesh>(test::boxMesh(0.5));
+  w.addBody("mesh", {{Shape::fromMesh(mesh), SE3()}}, SE3(), BodyKind::kStatic);
+  w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}}, at({0.1, 0.1, 0.5 + 0.05 + 0.01}, rotY(kPi / 2)),
+            BodyKind::kMovable);
+  ContactSet cs;
+  w.query(0, cs);
+  ASSERT_GE(cs.contacts.size(), 2u);
+  ASSERT_LE(cs.contacts.size(), 4u);
+  double xmin = 1e9, xmax = -1e9;
+  for (const auto& c : cs.contacts) {
+    EXPECT_NEAR(c.distance, 0.01, 1e-12);
+    EXPECT_TRUE(c.normal.isApprox(Vector3::UnitZ(), 1e-12));
+    xmin = std::min(xmin, worldA(w, c).x());
+    xmax = std::max(xmax, worldA(w, c).x());
+  }
+  EXPECT_NEAR(xmin, -0.1, 1e-12);
+  EXPECT_NEAR(xmax, 0.3, 1e-12);
+  expectConsistent(w, cs);
+}
+
+TEST(World, BoxRestingOnPlaneFourCorners) {
+  World w = floorWorld(0.02);
+  const int box = w.addBody("box", {{Shape::box({0.4, 0.3, 0.2}), SE3()}}, at({1, 2, 0.105}, rpy(0, 0, 0.3)),
+                            BodyKind::kMovable);
+  ContactSet cs;
+  w.query(0, cs);
+  ASSERT_EQ(cs.contacts.size(), 4u);
+  std::set<std::pair<int, int>> corners;
+  for (const auto& c : cs.contacts) {
+    EXPECT_EQ(c.body_b, box);
+    EXPECT_NEAR(c.distance, 0.005, 1e-12);
+    EXPECT_TRUE(c.normal.isApprox(Vector3::UnitZ()));
+    EXPECT_NEAR(std::abs(c.point_b.x()), 0.2, 1e-12);
+    EXPECT_NEAR(std::abs(c.point_b.y()), 0.15, 1e-12);
+    EXPECT_NEAR(c.point_b.z(), -0.1, 1e-12);
+    corners.insert({c.point_b.x() > 0, c.point_b.y() > 0});
+  }
+  EXPECT_EQ(corners.size(), 4u);
+  expectConsistent(w, cs);
+}
+
+TEST(World, BoxOnTableBoxFourCorners) {
+  WorldOptions o;
+  o.activation_distance = 0.02;
+  World w(o);
+  w.addBody("table", {{Shape::box({1.2, 0.8, 0.04}), at({0, 0, 0.73})}}, SE3(), BodyKind::kStatic);
+  const int box = w.addBody("box", {{Shape::box({0.2, 0.2, 0.1}), SE3()}}, at({0.1, 0.1, 0.75 + 0.05 + 0.004}),
+                            BodyKind::kMovable);
+  ContactSet cs;
+  w.query(0, cs);
+  ASSERT_EQ(cs.contacts.size(), 4u);
+  for (const auto& c : cs.contacts) {
+    EXPECT_EQ(c.body_b, box);
+    EXPECT_NEAR(c.distance, 0.004, 1e-6);
+    EXPECT_TRUE(c.normal.isApprox(Vector3::UnitZ(), 1e-9));
+    EXPECT_NEAR(std::abs(c.point_b.x()), 0.1, 1e-9);
+    EXPECT_NEAR(std::abs(c.point_b.y()), 0.1, 1e-9);
+  }
+  expectConsistent(w, cs);
+}
+
+TEST(World, MarginsShiftByTwiceTheMargin) {
+  auto make = [](double margin) {
+    World w = floorWorld();
+    w.setMargin(0, margin);
+    w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}}, at({0.3, 0, 0.08}, rotY(1.4)), BodyKind::kMovable,
+              margin);
+    w.addBody("box", {{Shape::box({0.2, 0.2, 0.2}), SE3()}}, at({2, 0, 0.11}, rpy(0.1, 0, 0)),
+              BodyKind::kMovable, margin);
+    return w;
+  };
+  World w0 = make(0.0), w1 = make(0.003);
+  ContactSet c0, c1;
+  w0.query(0, c0);
+  w1.query(0, c1);
+  ASSERT_EQ(c0.contacts.size(), c1.contacts.size());
+  ASSERT_GE(c0.contacts.size(), 3u);
+  for (std::size_t k = 0; k < c0.contacts.size(); ++k) {
+    EXPECT_NEAR(c1.contacts[k].distance, c0.contacts[k].distance - 2 * 0.003, 1e-15);
+    // witness points moved onto the margin shells
+    EXPECT_TRUE((worldA(w1, c1.contacts[k]) - worldA(w0, c0.contacts[k])).isApprox(0.003 * c0.contacts[k].normal));
+  }
+  expectConsistent(w1, c1);
+  // one margin only: shift by that margin
+  World w2 = make(0.0);
+  w2.setMargin(0, 0.004);
+  ContactSet c2;
+  w2.query(0, c2);
+  ASSERT_EQ(c0.contacts.size(), c2.contacts.size());
+  for (std::size_t k = 0; k < c0.contacts.size(); ++k)
+    EXPECT_NEAR(c2.contacts[k].distance, c0.contacts[k].distance - 0.004, 1e-15);
+}
+
+TEST(World, StandingMannequinFeetFlatFourPointsEach) {
+  const auto model = mannequinModel();
+  skeleton::Data data(model);
+  skeleton::forwardKinematics(model, data, skeleton::standingConfiguration(model));
+  World w = floorWorld(0.01);  // the shanks' lower ends are 2 cm above the floor
+  const int m = w.addMannequin(model);
+  w.updateMannequin(m, data);
+  ContactSet cs;
+  w.query(0, cs);
+  for (const char* foot : {"mannequin0/foot_l", "mannequin0/foot_r"}) {
+    const auto cf = between(w, cs, "scene/floor", foot);
+    ASSERT_EQ(cf.size(), 4u) << foot;
+    for (const auto& c : cf) EXPECT_NEAR(c.distance, 0.0, 1e-9);
+  }
+  for (const auto& c : cs.contacts)  // nothing else touches the floor
+    if (c.body_a == 0) {
+      EXPECT_NE(w.bodyName(c.body_b).find("foot"), std::string::npos) << w.bodyName(c.body_b) << " " << c.distance;
+    }
+  expectConsistent(w, cs);
+}
+
+TEST(World, AdjacentSegmentsNeverReportedSelfContactsAre) {
+  const auto model = mannequinModel();
+  skeleton::Data data(model);
+  WorldOptions o;
+  o.activation_distance = 0.05;
+  World w(o);
+  const int m = w.addMannequin(model);
+  const std::vector<std::pair<std::string, std::string>> adjacent = {
+      {"pelvis", "abdomen"}, {"abdomen", "thorax"}, {"thorax", "head"}, {"thorax", "clavicle_l"},
+      {"clavicle_l", "upper_arm_l"}, {"upper_arm_l", "forearm_l"}, {"forearm_l", "hand_l"},
+      {"pelvis", "thigh_l"}, {"thigh_l", "shank_l"}, {"shank_l", "foot_l"}, {"upper_arm_r", "forearm_r"},
+      {"forearm_r", "hand_r"}, {"shank_r", "foot_r"}};
+  for (const auto& [a, b] : adjacent)
+    EXPECT_FALSE(w.pairEnabled(w.findBody("mannequin0/" + a), w.findBody("mannequin0/" + b))) << a << " " << b;
+  std::mt19937 g(3);
+  int self_contacts = 0;
+  ContactSet cs;
+  for (int trial = 0; trial < 200; ++trial) {
+    math::VectorX q(model.nq);
+    for (int k = 0; k < model.nq; ++k) {
+      const double lo = std::isfinite(model.lower_limit[k]) ? model.lower_limit[k] : -1.0;
+      const double hi = std::isfinite(model.upper_limit[k]) ? model.upper_limit[k] : 1.0;
+      q[k] = std::uniform_real_distribution<double>(lo, hi)(g);
+    }
+    skeleton::forwardKinematics(model, data, q);
+    w.updateMannequin(m, data);
+    w.query(trial, cs);
+    for (const auto& c : cs.contacts) {
+      const std::string a = w.bodyName(c.body_a).substr(11), b = w.bodyName(c.body_b).substr(11);
+      for (const auto& [x, y] : adjacent) EXPECT_FALSE((a == x && b == y) || (a == y && b == x)) << a << " " << b;
+      ++self_contacts;
+    }
+    expectConsistent(w, cs);
+  }
+  EXPECT_GT(self_contacts, 50);  // self-collision is on and does fire
+}
+
+TEST(World, TwoMannequinsCollide) {
+  const auto model = mannequinModel();
+  skeleton::Data d0(model), d1(model);
+  auto q = skeleton::standingConfiguration(model);
+  skeleton::forwardKinematics(model, d0, q);
+  q[0] += 0.25;  // the second one 25 cm ahead, turned around: they overlap
+  q[5] = kPi;
+  skeleton::forwardKinematics(model, d1, q);
+  World w = floorWorld(0.02);
+  const int a = w.addMannequin(model);
+  const int b = w.addMannequin(model);
+  EXPECT_EQ(w.mannequinCount(), 2);
+  w.updateMannequin(a, d0);
+  w.updateMannequin(b, d1);
+  ContactSet cs;
+  w.query(0, cs);
+  int cross = 0;
+  for (const auto& c : cs.contacts)
+    if (w.bodyName(c.body_a).rfind("mannequin0/", 0) == 0 && w.bodyName(c.body_b).rfind("mannequin1/", 0) == 0)
+      ++cross;
+  EXPECT_GT(cross, 0);
+  expectConsistent(w, cs);
+}
+
+TEST(World, DeterministicWhateverTheHistory) {
+  const auto model = mannequinModel();
+  skeleton::Data data(model);
+  auto build = [&] {
+    World w = floorWorld(0.05);
+    w.addBody("scene/table", {{Shape::box({1.2, 0.8, 0.04}), at({0.5, 0, 0.73})}}, SE3(), BodyKind::kStatic);
+    w.addMannequin(model);
+    w.addBody("scene/ball", {{Shape::sphere(0.1), SE3()}}, at({0.5, 0, 0.85}), BodyKind::kMovable);
+    return w;
+  };
+  World w1 = build(), w2 = build();
+  const auto q0 = skeleton::standingConfiguration(model);
+  std::mt19937 g(11);
+  std::normal_distribution<double> n(0.0, 0.4);
+  ContactSet c1, c2;
+  for (int step = 0; step < 30; ++step) {
+    math::VectorX q = q0;
+    for (int k = 6; k < model.nq; ++k) q[k] += n(g);
+    skeleton::forwardKinematics(model, data, q);
+    w1.updateMannequin(0, data);
+    w2.updateMannequin(0, data);
+    if (step % 3 == 0) {  // w2 makes a detour (other tree shapes) before coming back
+      w2.setBodyPose(w2.findBody("scene/ball"), at({9, 9, 9}));
+      w2.query(step, c2);
+      w2.setBodyPose(w2.findBody("scene/ball"), at({0.5, 0, 0.85}));
+    }
+    w1.query(step, c1);
+    w2.query(step, c2);
+    ASSERT_EQ(c1.contacts.size(), c2.contacts.size());
+    for (std::size_t k = 0; k < c1.contacts.size(); ++k) {
+      const Contact& a = c1.contacts[k];
+      const Contact& b = c2.contacts[k];
+      EXPECT_EQ(a.body_a, b.body_a);
+      EXPECT_EQ(a.body_b, b.body_b);
+      EXPECT_EQ(a.feature, b.feature);
+      EXPECT_EQ(std::memcmp(&a.distance, &b.distance, sizeof(double)), 0);
+      EXPECT_EQ(std::memcmp(a.point_a.data(), b.point_a.data(), 3 * sizeof(double)), 0);
+      EXPECT_EQ(std::memcmp(a.point_b.data(), b.point_b.data(), 3 * sizeof(double)), 0);
+      EXPECT_EQ(std::memcmp(a.normal.data(), b.normal.data(), 3 * sizeof(double)), 0);
+      if (k > 0) {  // sorted
+        const Contact& p = c1.contacts[k - 1];
+        EXPECT_TRUE(std::tie(p.body_a, p.body_b, p.shape_a, p.shape_b) <=
+                    std::tie(a.body_a, a.body_b, a.shape_a, a.shape_b));
+      }
+    }
+  }
+}
+
+TEST(World, BadArgumentsThrowClearly) {
+  World w = floorWorld();
+  EXPECT_THROW(w.setBodyPose(0, SE3()), std::invalid_argument);  // static
+  const int b = w.addBody("b", {{Shape::sphere(0.1), SE3()}}, SE3(), BodyKind::kMovable);
+  SE3 bad;
+  bad.p.x() = std::nan("");
+  EXPECT_THROW(w.setBodyPose(b, bad), std::invalid_argument);
+  EXPECT_THROW(w.setBodyPose(99, SE3()), std::invalid_argument);
+  EXPECT_THROW(w.addBody("b", {{Shape::sphere(0.1), SE3()}}, SE3(), BodyKind::kMovable), std::invalid_argument);
+  EXPECT_THROW(w.setMargin(b, -0.1), std::invalid_argument);
+  EXPECT_THROW(Shape::sphere(-0.1), std::invalid_argument);
+  EXPECT_THROW(Shape::capsule(0.1, std::nan("")), std::invalid_argument);
+  EXPECT_THROW(Shape::box({0.1, 0.0, 0.1}), std::invalid_argument);
+  const auto model = mannequinModel();
+  MannequinOptions o;
+  o.exclude_pairs = {{"hand_l", "tail"}};
+  try {
+    w.addMannequin(model, o);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'tail'"), std::string::npos);
+  }
+  skeleton::Data data(model);
+  EXPECT_THROW(w.updateMannequin(5, data), std::invalid_argument);
+}
