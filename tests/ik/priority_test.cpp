@@ -74,6 +74,7 @@ TEST(PriorityLoop, RecursiveProjectorEqualsFullRecomputation) {
   for (int p = 1; p <= 9; ++p) {
     auto levels = randomLevels(p, 5, n, g, 0.01);
     if (p >= 3) levels[p - 1].J.row(0) = levels[0].J.row(2) - 2.0 * levels[1].J.row(4);  // dependent row
+    levels[p - 1].damping = 0.0;  // (a damped last level needs no projector: see below)
     PriorityLoop rec(n, {ProjectorUpdate::kRecursive, 1e-9}), full(n, {ProjectorUpdate::kFull, 1e-9});
     const VectorX a = rec.solve(levels);
     const VectorX b = full.solve(levels);
@@ -83,6 +84,24 @@ TEST(PriorityLoop, RecursiveProjectorEqualsFullRecomputation) {
     if (p >= 3) {
       EXPECT_EQ(rec.ranks()[p - 1], 4);
     }
+  }
+}
+
+TEST(PriorityLoop, DampedLastLevelByCholeskyEqualsTheSvdForm) {
+  // the last level, damped, is solved on its Gram matrix; same result as Ĵ^{+λ} by SVD
+  std::mt19937 g(9);
+  for (int m_last : {3, 40}) {  // fewer and more rows than coordinates
+    const int n = 25;
+    auto levels = randomLevels(3, 4, n, g);
+    levels.push_back({randomMatrix(m_last, n, g), randomVector(m_last, g), 0.2});
+    PriorityLoop loop(n);
+    const VectorX d = loop.solve(levels);
+    PriorityLoop head(n);
+    const VectorX d3 = head.solve({levels[0], levels[1], levels[2]});
+    const MatrixX& P3 = head.projector();
+    const VectorX expected =
+        d3 + dampedInverse(levels[3].J * P3, 0.2) * (levels[3].dx - levels[3].J * d3);
+    EXPECT_LT((d - expected).norm(), 1e-10) << "m_last " << m_last;
   }
 }
 

@@ -85,6 +85,27 @@ const VectorX& PriorityLoop::solve(const std::vector<LinearLevel>& levels, const
     Jhat_.noalias() = L.J * P_;
     r_ = L.dx;
     r_.noalias() -= L.J * dtheta_;
+    const bool last = k + 1 == levels.size();
+    if (last && L.damping > 0.0) {
+      // No projector is needed after the last level: Ĵ^{+λ} r = Ĵᵀ(ĴĴᵀ + λ²I)⁻¹ r by Cholesky
+      // (or (ĴᵀĴ + λ²I)⁻¹Ĵᵀ r when m > n), much cheaper than an SVD for a tall posture level.
+      const double l2 = L.damping * L.damping;
+      if (m <= n_) {
+        MatrixX G = Jhat_ * Jhat_.transpose();
+        G.diagonal().array() += l2;
+        step.noalias() = Jhat_.transpose() * G.llt().solve(r_);
+      } else {
+        MatrixX G = Jhat_.transpose() * Jhat_;
+        G.diagonal().array() += l2;
+        step = G.llt().solve(Jhat_.transpose() * r_);
+      }
+      ranks_[k] = -1;  // not computed
+      const double smax = step.lpNorm<Eigen::Infinity>();
+      if (smax > options_.max_step) step *= options_.max_step / smax;
+      dtheta_ += step;
+      C_.col(static_cast<Eigen::Index>(k)) = step;
+      continue;
+    }
     Eigen::JacobiSVD<MatrixX> svd(Jhat_.transpose(), Eigen::ComputeThinU | Eigen::ComputeThinV);
     ranks_[k] = applyInverse(svd, r_, L.damping, tol, w_, step);
     const double smax = step.lpNorm<Eigen::Infinity>();

@@ -17,7 +17,9 @@
 /// never moves any higher level, whatever its damping (strictness).
 ///
 /// Every pseudo-inverse comes from one thin SVD of Ĵᵀ (n × m, m ≤ n small): Ĵ^+, Ĵ^{+λ} and the
-/// row-space projector Ĵ^+Ĵ = U_r U_rᵀ from the same factorisation. The coordinates Δθ are
+/// row-space projector Ĵ^+Ĵ = U_r U_rᵀ from the same factorisation. The last level, when
+/// damped, needs no projector and is solved by Cholesky on its Gram matrix (its rank is then
+/// reported as −1). The coordinates Δθ are
 /// whatever the Jacobians' columns are (the IK solver uses its own, see solver.hpp).
 #include <limits>
 #include <vector>
@@ -69,7 +71,8 @@ class PriorityLoop {
   const PriorityOptions& options() const { return options_; }
   void setUpdate(ProjectorUpdate u) { options_.update = u; }
 
-  /// After solve(): Δθ_k after level k (k = 1..p), the final projector P_p, the rank of Ĵ_k.
+  /// After solve(): Δθ_p, the last projector computed (P_{p−1} when the last level is damped,
+  /// else P_p), the rank of each Ĵ_k (−1: not computed).
   const VectorX& dtheta() const { return dtheta_; }
   const MatrixX& projector() const { return P_; }
   const std::vector<int>& ranks() const { return ranks_; }
