@@ -77,8 +77,8 @@ RetargetFrame Retargeter::solve(long long frame) {
   for (std::size_t i = 0; i < tasks_.size(); ++i) tasks_[i]->setTarget(actorPose(world, static_cast<int>(i)) * offset_[i]);
   const VectorX transfer = driver_.drive(f).q;
   posture_->setReference(transfer);
-  if (!warm_) {
-    q_ = transfer;  // first solved frame: start from the orientation transfer
+  if (!warm_ || !options_.warm_start) {
+    q_ = transfer;  // start from the orientation transfer of this frame
     warm_ = true;
   }
   RetargetFrame out;

@@ -3,7 +3,7 @@
 /// \brief Kinematic retargeting of an actor's captured motion (BVH) onto a mannequin of another
 /// size with the strict-priority IK (thesis 1.4.1, Fig. 1.9–1.10, 1.30, 2.12).
 ///
-/// Per frame, from the previous frame's solution (warm start):
+/// Per frame, from the frame's orientation transfer (or the previous solution, warm_start):
 /// - the actor's segment poses G_s(t) come from the BVH (axes turned into the mannequin's world:
 ///   z up, x forward), unscaled: the Cartesian constraints (feet on the floor, hands on the
 ///   object) are kept in absolute space, constraint-oriented retargeting (Fig. 1.9 left);
@@ -31,7 +31,10 @@ struct RetargetOptions {
   /// rest pose, all channels zero, e.g. a T-pose, against the mannequin's transfer of it).
   std::string calibration = "first";
   long long calibration_frame = 0;
-  int max_iterations = 30;  ///< convergence loop per frame (warm-started)
+  int max_iterations = 30;  ///< convergence loop per frame
+  /// Start each frame from the previous solution (true) or from the frame's orientation
+  /// transfer (false: no drift into a wrong local minimum over long captures).
+  bool warm_start = false;
   double feet_tolerance = 1e-3, pelvis_tolerance = 2e-3, hands_tolerance = 2e-3;  ///< m/rad
 };
 
@@ -47,7 +50,7 @@ class Retargeter {
   Retargeter(const Model& model, const skeleton::Bvh& bvh, const skeleton::BvhDriveMap& map,
              RetargetOptions options = {});
 
-  /// Solves frame `frame` (negative counts from the end), warm-started from the last call.
+  /// Solves frame `frame` (negative counts from the end).
   RetargetFrame solve(long long frame);
 
   /// The controlled segments, in the order of their tasks.
