@@ -405,6 +405,13 @@ void meshConvex(const ShapeView& mesh, const ShapeView& y, double cutoff, const 
     face.point = a;
     face.infinite = false;
     if (round) {
+      // bounding sphere of the triangle against the segment: cheap rejection
+      const Vector3 g = (a + b + c) / 3.0;
+      const double rg = std::sqrt(std::max({(a - g).squaredNorm(), (b - g).squaredNorm(), (c - g).squaredNorm()}));
+      const Vector3 seg = p1 - p0;
+      const double ls = seg.squaredNorm();
+      const double tg = ls > 0.0 ? std::clamp(seg.dot(g - p0) / ls, 0.0, 1.0) : 0.0;
+      if ((p0 + tg * seg - g).norm() - rg - ys.radius > cutoff) continue;
       Vector3 cs, ct;
       const double dist = closestSegmentTriangle(p0, p1, a, b, c, cs, ct);
       const double d = dist - ys.radius;
@@ -455,64 +462,63 @@ void meshConvex(const ShapeView& mesh, const ShapeView& y, double cutoff, const 
 double triArea(const Vector3& a, const Vector3& b, const Vector3& c) { return (b - a).cross(c - a).norm(); }
 
 void reduce(std::vector<RawPoint>& out, std::size_t start, int max_points, NarrowScratch& sc) {
-  // drop duplicates (same point on both bodies)
+  const int n = static_cast<int>(out.size() - start);
+  const RawPoint* pts = out.data() + start;
+  auto same = [](const RawPoint& a, const RawPoint& b) {
+    return (a.px - b.px).squaredNorm() < 1e-12 && (a.py - b.py).squaredNorm() < 1e-12;
+  };
   auto& red = sc.reduced;
   red.clear();
-  for (std::size_t k = start; k < out.size(); ++k) {
-    bool dup = false;
-    for (const auto& r : red)
-      if ((r.px - out[k].px).squaredNorm() < 1e-12 && (r.py - out[k].py).squaredNorm() < 1e-12) {
-        dup = true;
-        break;
-      }
-    if (!dup) red.push_back(out[k]);
-  }
-  const int n = static_cast<int>(red.size());
-  out.resize(start);
-  if (n <= max_points) {
-    out.insert(out.end(), red.begin(), red.end());
-    return;
-  }
-  std::array<int, 8> sel{};
-  auto& used = sc.used;
-  used.assign(n, 0);
-  const int limit = n;
-  // 1: deepest
-  int best = 0;
-  for (int k = 1; k < limit; ++k)
-    if (red[k].d < red[best].d) best = k;
-  sel[0] = best;
-  used[best] = 1;
-  int count = 1;
-  auto pick = [&](auto score) {
-    int arg = -1;
-    double top = -1.0;
-    for (int k = 0; k < limit; ++k) {
-      if (used[k]) continue;
-      const double v = score(red[k].py);
-      if (v > top + 1e-15) {
-        top = v;
-        arg = k;
-      }
+  if (n <= max_points) {  // few points: only drop duplicates
+    for (int k = 0; k < n; ++k) {
+      bool dup = false;
+      for (const auto& r : red) dup = dup || same(r, pts[k]);
+      if (!dup) red.push_back(pts[k]);
     }
-    if (arg >= 0) {
+  } else {
+    // deepest, then farthest from it, then largest triangle, then largest added area; a point
+    // that adds nothing (duplicate, collinear) is never picked. O(n · max_points).
+    std::array<int, 8> sel{};
+    auto& used = sc.used;
+    used.assign(n, 0);
+    int best = 0;
+    for (int k = 1; k < n; ++k)
+      if (pts[k].d < pts[best].d) best = k;
+    sel[0] = best;
+    used[best] = 1;
+    int count = 1;
+    auto pick = [&](auto score) {
+      int arg = -1;
+      double top = 1e-12;
+      for (int k = 0; k < n; ++k) {
+        if (used[k]) continue;
+        const double v = score(pts[k].py);
+        if (v > top) {
+          top = v;
+          arg = k;
+        }
+      }
+      if (arg < 0) return false;
       used[arg] = 1;
       sel[count++] = arg;
+      return true;
+    };
+    bool more = max_points >= 2 && pick([&](const Vector3& p) { return (p - pts[sel[0]].py).squaredNorm(); });
+    if (more && max_points >= 3)
+      more = pick([&](const Vector3& p) { return triArea(pts[sel[0]].py, pts[sel[1]].py, p); });
+    while (more && count < max_points) {
+      more = pick([&](const Vector3& p) {
+        double s = 0.0;
+        for (int k = 0; k < count; ++k) s += triArea(pts[sel[k]].py, pts[sel[(k + 1) % count]].py, p);
+        return s - triArea(pts[sel[0]].py, pts[sel[1]].py, pts[sel[2]].py);
+      });
     }
-  };
-  // 2: farthest from it; 3: largest triangle; 4+: largest added area
-  pick([&](const Vector3& p) { return (p - red[sel[0]].py).squaredNorm(); });
-  if (max_points >= 3) pick([&](const Vector3& p) { return triArea(red[sel[0]].py, red[sel[1]].py, p); });
-  while (count < max_points && count < limit) {
-    pick([&](const Vector3& p) {
-      double s = 0.0;
-      for (int k = 0; k < count; ++k) s += triArea(red[sel[k]].py, red[sel[(k + 1) % count]].py, p);
-      return s;
-    });
+    for (int i = 1; i < count; ++i)  // keep generation order (insertion sort)
+      for (int k = i; k > 0 && sel[k - 1] > sel[k]; --k) std::swap(sel[k - 1], sel[k]);
+    for (int k = 0; k < count; ++k) red.push_back(pts[sel[k]]);
   }
-  for (int i = 1; i < count; ++i)  // keep generation order (insertion sort)
-    for (int k = i; k > 0 && sel[k - 1] > sel[k]; --k) std::swap(sel[k - 1], sel[k]);
-  for (int k = 0; k < count; ++k) out.push_back(red[sel[k]]);
+  out.resize(start);
+  out.insert(out.end(), red.begin(), red.end());
 }
 
 }  // namespace
