@@ -1,0 +1,69 @@
+#include "mannequin/sim/mocap_buffer.hpp"
+
+namespace mannequin::sim {
+
+namespace {
+const BodyInput* findBody(const MocapInput& f, const std::string& name) {
+  for (const BodyInput& b : f.bodies)
+    if (b.name == name) return &b;
+  return nullptr;
+}
+}  // namespace
+
+bool MocapBuffer::add(const MocapInput& frame) {
+  if (!frames_.empty() && frame.stamp_ns <= frames_.back().stamp_ns) return false;
+  frames_.push_back(frame);
+  while (frames_.size() > 2 && frames_.back().stamp_ns - frames_.front().stamp_ns > window_ns_) frames_.pop_front();
+  for (const BodyInput& b : frame.bodies) {
+    if (!b.tracked) continue;
+    bool found = false;
+    for (LastTracked& l : last_tracked_)
+      if (l.name == b.name) {
+        l.pose = b.pose;
+        l.stamp_ns = frame.stamp_ns;
+        found = true;
+      }
+    if (!found) last_tracked_.push_back({b.name, b.pose, frame.stamp_ns});
+  }
+  return true;
+}
+
+BodySample MocapBuffer::sample(const std::string& body, std::int64_t t_ns) const {
+  BodySample out;
+  for (const LastTracked& l : last_tracked_)
+    if (l.name == body) {
+      out.pose = l.pose;
+      out.last_tracked_ns = l.stamp_ns;
+      out.ever_tracked = true;
+    }
+  if (frames_.empty()) return out;
+  // first frame after t
+  std::size_t k = 0;
+  while (k < frames_.size() && frames_[k].stamp_ns <= t_ns) ++k;
+  if (k == frames_.size() || k == 0) {  // past the newest (or before the oldest): that frame
+    const MocapInput& f = k == 0 ? frames_.front() : frames_.back();
+    const BodyInput* b = findBody(f, body);
+    if (b != nullptr && b->tracked) {
+      out.pose = b->pose;
+      out.tracked = true;
+    }
+    return out;
+  }
+  const MocapInput& f0 = frames_[k - 1];
+  const MocapInput& f1 = frames_[k];
+  const BodyInput* b0 = findBody(f0, body);
+  const BodyInput* b1 = findBody(f1, body);
+  const bool t0 = b0 != nullptr && b0->tracked, t1 = b1 != nullptr && b1->tracked;
+  if (t0 && t1) {
+    const double gamma = static_cast<double>(t_ns - f0.stamp_ns) / static_cast<double>(f1.stamp_ns - f0.stamp_ns);
+    out.pose = math::interpolate(b0->pose, b1->pose, gamma);
+    out.tracked = true;
+  } else if (t0) {
+    out.pose = b0->pose;
+    out.tracked = true;
+  }
+  // t0 untracked: occluded at t (the newer frame is not known to the past)
+  return out;
+}
+
+}  // namespace mannequin::sim

@@ -1,0 +1,49 @@
+#pragma once
+/// \file config.hpp
+/// \brief The sim service's YAML config (configs/sim/sim_*.yaml; reference in docs/cluster.md).
+#include <string>
+#include <vector>
+
+#include "mannequin/service/config.hpp"
+#include "mannequin/sim/world.hpp"
+
+namespace mannequin::simservice {
+
+enum class Mode { kLive, kReplay };
+enum class CollisionMode { kNone, kService };
+
+struct CollisionSettings {
+  CollisionMode mode = CollisionMode::kNone;
+  int period_steps = 10;     ///< a query every this many steps
+  double deadline = 0.005;   ///< s to wait for the contacts of a query (live mode); past it: stale
+  double replay_deadline = 2.0;  ///< s (replay mode waits this long before flagging stale)
+  double margin = 0.02;      ///< m
+};
+
+struct MannequinEntry {
+  std::string name;
+  std::string config;        ///< configs/mannequins/*.yaml
+  std::string root_frame = "pelvis";
+  std::vector<sim::ControlFrameSpec> frames;
+};
+
+struct SimServiceConfig {
+  std::string name = "sim";
+  std::vector<std::string> publish, connect;
+  Mode mode = Mode::kLive;
+  double world_rate = 60.0;   ///< sim.world per second of simulation time (≤ 1/step)
+  bool publish_on_mocap = false;  ///< also publish sim.world at the first step after each new mocap frame
+  double reanchor_threshold = 0.5;  ///< s: live capture clock drifted this far → re-anchor
+  sim::SimConfig world;
+  std::vector<MannequinEntry> mannequins;
+  CollisionSettings collision;
+};
+
+/// \throws service::ConfigError "FILE:LINE: field '...': ...".
+SimServiceConfig parseSimConfig(const service::ConfigNode& root);
+SimServiceConfig loadSimConfig(const std::string& path);
+
+/// Builds the World's mannequins (loads every mannequin config). \throws service::ConfigError.
+std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config);
+
+}  // namespace mannequin::simservice

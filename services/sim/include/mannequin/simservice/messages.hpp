@@ -1,0 +1,22 @@
+#pragma once
+/// \file messages.hpp
+/// \brief Conversions between the World and the mannequin.v1 messages.
+#include <mannequin/v1/collision.pb.h>
+#include <mannequin/v1/mocap.pb.h>
+#include <mannequin/v1/world.pb.h>
+
+#include "mannequin/sim/world.hpp"
+
+namespace mannequin::simservice {
+
+/// MocapFrame → World input (untracked bodies keep tracked = false).
+sim::MocapInput toInput(const v1::MocapFrame& frame);
+
+/// The World's state (header.stamp_ns = simulation time; the publisher fills the rest). `contacts`
+/// (may be null): the contact set in use, with `stale` when it is older than its deadline.
+void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool stale, bool replay, v1::WorldState& out);
+
+/// The collision query of the current step (every mannequin's configuration).
+void toCollisionQuery(const sim::World& world, double margin, v1::CollisionQuery& out);
+
+}  // namespace mannequin::simservice
