@@ -113,7 +113,7 @@ TEST(Retarget, RejectsAMapWithoutTheControlledSegments) {
 }
 
 int run(const std::string& args) {
-  const int status = std::system(("./build/bin/mannequin-retarget " + args + " > /tmp/mannequin-retarget-test.log 2>&1").c_str());
+  const int status = std::system((std::string(MANNEQUIN_BIN_DIR) + "/mannequin-retarget " + args + " > /tmp/mannequin-retarget-test.log 2>&1").c_str());
   return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 }
 
