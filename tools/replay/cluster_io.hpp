@@ -1,0 +1,35 @@
+#pragma once
+// What mannequin-record and mannequin-replay share: endpoints from a deployment file, the Header
+// of a raw payload, the schema of a topic, signals.
+#include <atomic>
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+namespace mannequin::tools {
+
+/// Every endpoint listed under a key named `publish` anywhere in the deployment YAML file (a
+/// string or a list of strings), in file order, without duplicates. These are where the
+/// services bind their publishers, i.e. what a recorder connects to.
+/// \throws std::runtime_error "FILE:LINE: ..." for unreadable YAML or a bad `publish` value.
+std::vector<std::string> publishEndpoints(const std::string& deployment_file);
+
+/// Header fields of a raw mannequin.v1 payload (field 1 of every top-level message).
+struct RawHeader {
+  std::uint64_t sequence = 0;
+  std::int64_t stamp_ns = 0;
+  std::int64_t send_time_ns = 0;
+  std::string source;
+};
+/// nullopt when the payload is not a protobuf message with a Header in field 1.
+std::optional<RawHeader> parseHeader(std::string_view payload);
+
+/// "a,b , c" -> {"a","b","c"} (empty parts dropped).
+std::vector<std::string> splitList(const std::string& s);
+
+/// SIGINT/SIGTERM set the returned flag; SIGPIPE ignored.
+const std::atomic<bool>& stopOnSignals();
+
+}  // namespace mannequin::tools
