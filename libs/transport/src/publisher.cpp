@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <cerrno>
 #include <stdexcept>
 
 #include "mannequin/transport/clock.hpp"
@@ -84,7 +85,13 @@ void Publisher::publishRaw(std::string_view topic, std::string_view payload) {
 int Publisher::poll() {
   int n = 0;
   zmq::message_t msg;
-  while (socket_.recv(msg, zmq::recv_flags::dontwait)) {
+  for (;;) {
+    try {
+      if (!socket_.recv(msg, zmq::recv_flags::dontwait)) break;
+    } catch (const zmq::error_t& e) {
+      if (e.num() == EINTR) break;  // a signal: read the rest next time
+      throw;
+    }
     ++n;
     const auto* data = static_cast<const char*>(msg.data());
     if (msg.size() < 1 || data[0] != 1) continue;  // unsubscribe (0) or garbage

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
+#include <cerrno>
 #include <stdexcept>
 #include <thread>
 
@@ -120,6 +121,15 @@ void Subscriber::dispatch(Entry& entry, const google::protobuf::Message& m, cons
 }
 
 int Subscriber::poll(std::chrono::microseconds timeout) {
+  try {
+    return pollImpl(timeout);
+  } catch (const zmq::error_t& e) {
+    if (e.num() != EINTR) throw;
+    return delivered_in_poll_;  // a signal arrived (the caller checks its stop flag)
+  }
+}
+
+int Subscriber::pollImpl(std::chrono::microseconds timeout) {
   delivered_in_poll_ = 0;
   zmq::pollitem_t item{socket_.handle(), 0, ZMQ_POLLIN, 0};
   const long timeout_ms = static_cast<long>((timeout.count() + 999) / 1000);

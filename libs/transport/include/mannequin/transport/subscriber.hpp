@@ -83,7 +83,8 @@ class Subscriber {
   void subscribeRaw(const std::string& prefix, RawHandler handler);
 
   /// Waits up to `timeout` for the first frame (0 = do not wait), then drains what is queued and
-  /// dispatches. Returns the number of messages handed to handlers.
+  /// dispatches. Returns the number of messages handed to handlers. A signal interrupting the wait
+  /// ends it early (EINTR is not an error).
   int poll(std::chrono::microseconds timeout);
 
   /// Counters of every typed topic subscribed.
@@ -110,6 +111,7 @@ class Subscriber {
     TopicCounters counters;
     std::unordered_map<std::string, std::uint64_t> last_sequence;  // per source
   };
+  int pollImpl(std::chrono::microseconds timeout);
   void add(std::string_view topic, std::unique_ptr<Entry> entry);
   bool accept(Entry& entry, std::string_view topic, const zmq::message_t& payload);
   void dispatch(Entry& entry, const google::protobuf::Message& m, const Received& r);
