@@ -1,0 +1,123 @@
+#include "mannequin/control/projector.hpp"
+
+#include <stdexcept>
+
+namespace mannequin::control {
+
+const char* toString(ProjectorMethod method) { return method == ProjectorMethod::kSvd ? "svd" : "ldlt"; }
+
+WeightedNullSpace::WeightedNullSpace(int rows, int n, ProjectorMethod method, double rank_tolerance)
+    : rows_(rows), n_(n), method_(method), tol_(rank_tolerance) {
+  if (rows < 0 || n <= 0) throw std::invalid_argument("WeightedNullSpace: bad size");
+  if (!(rank_tolerance > 0) || !(rank_tolerance < 1))
+    throw std::invalid_argument("WeightedNullSpace: rank tolerance must be in (0, 1)");
+  J_.setZero(rows, n);
+  w_inv_.setOnes(n);
+  sqrt_w_inv_.setOnes(n);
+  Js_.setZero(rows, n);
+  G_.setZero(rows, rows);
+  y_.setZero(rows);
+  z_.setZero(rows);
+  t_.setZero(n);
+  r_.setZero(rows);
+  if (rows > 0) {
+    if (method == ProjectorMethod::kLdlt) {
+      ldlt_ = Eigen::LDLT<MatrixX>(rows);
+    } else {
+      svd_ = Eigen::JacobiSVD<MatrixX>(rows, n, Eigen::ComputeThinV);
+    }
+  }
+}
+
+void WeightedNullSpace::compute(const Eigen::Ref<const MatrixX>& J, const VectorX& w_inv) {
+  if (J.rows() != rows_ || J.cols() != n_ || w_inv.size() != n_)
+    throw std::invalid_argument("WeightedNullSpace::compute: J is " + std::to_string(J.rows()) + "x" +
+                                std::to_string(J.cols()) + ", expected " + std::to_string(rows_) + "x" +
+                                std::to_string(n_));
+  rank_ = 0;
+  if (rows_ == 0) return;
+  J_ = J;
+  w_inv_ = w_inv;
+  sqrt_w_inv_ = w_inv.cwiseSqrt();
+  // Js = J W^{-1/2}
+  Js_.noalias() = J_ * sqrt_w_inv_.asDiagonal();
+  if (method_ == ProjectorMethod::kLdlt) {
+    // G = J W⁻¹ Jᵀ (lower triangle), pivoted LDLᵀ; rank = pivots above tol · max pivot
+    G_.setZero();
+    G_.selfadjointView<Eigen::Lower>().rankUpdate(Js_);
+    ldlt_.compute(G_);
+    const auto& D = ldlt_.vectorD();
+    const double dmax = D.size() > 0 ? D.cwiseAbs().maxCoeff() : 0.0;
+    const double cut = tol_ * dmax;
+    for (Eigen::Index i = 0; i < D.size(); ++i)
+      if (D(i) > cut && dmax > 0) ++rank_;
+  } else {
+    svd_.compute(Js_, Eigen::ComputeThinV);
+    const auto& s = svd_.singularValues();
+    const double smax = s.size() > 0 ? s(0) : 0.0;
+    for (Eigen::Index i = 0; i < s.size(); ++i)
+      if (s(i) * s(i) > tol_ * smax * smax && smax > 0) ++rank_;
+  }
+}
+
+void WeightedNullSpace::projectTorque(const VectorX& g, VectorX& out) {
+  if (g.size() != n_) throw std::invalid_argument("WeightedNullSpace::projectTorque: wrong size");
+  if (rows_ == 0 || rank_ == 0) {
+    if (&out != &g) out = g;
+    return;
+  }
+  if (method_ == ProjectorMethod::kLdlt) {
+    // Πᵀg = g − Jᵀ G⁺ J W⁻¹ g, G⁺ = Pᵀ L⁻ᵀ D⁺ L⁻¹ P with the small pivots of D dropped
+    t_ = w_inv_.cwiseProduct(g);
+    y_.noalias() = J_ * t_;
+    z_ = ldlt_.transpositionsP() * y_;
+    ldlt_.matrixL().solveInPlace(z_);
+    const auto& D = ldlt_.vectorD();
+    const double cut = tol_ * D.cwiseAbs().maxCoeff();
+    for (Eigen::Index i = 0; i < z_.size(); ++i) z_(i) = D(i) > cut ? z_(i) / D(i) : 0.0;
+    ldlt_.matrixU().solveInPlace(z_);
+    y_ = ldlt_.transpositionsP().transpose() * z_;
+    t_.noalias() = J_.transpose() * y_;
+    out = g - t_;
+  } else {
+    // Πᵀ = I − S⁻¹ V_r V_rᵀ S, S = W^{-1/2}, Js = U Σ Vᵀ
+    const auto V = svd_.matrixV().leftCols(rank_);
+    t_ = sqrt_w_inv_.cwiseProduct(g);
+    auto r = r_.head(rank_);
+    r.noalias() = V.transpose() * t_;
+    t_.noalias() = V * r;
+    out = g - t_.cwiseQuotient(sqrt_w_inv_);
+  }
+}
+
+MatrixX WeightedNullSpace::matrix() {
+  // columns of Πᵀ are Πᵀ e_k; Π is its transpose
+  MatrixX PiT(n_, n_);
+  VectorX e(n_), col(n_);
+  for (int k = 0; k < n_; ++k) {
+    e.setZero();
+    e(k) = 1.0;
+    projectTorque(e, col);
+    PiT.col(k) = col;
+  }
+  return PiT.transpose();
+}
+
+AugmentedImpedance augmentedImpedance(const MatrixX& J, const VectorX& b_a_diag, double rank_tolerance) {
+  if (b_a_diag.size() != J.cols() || (b_a_diag.array() <= 0).any())
+    throw std::invalid_argument("augmentedImpedance: b_a must be a positive vector of J's column count");
+  const Eigen::JacobiSVD<MatrixX> svd(J, Eigen::ComputeFullV);
+  const auto& s = svd.singularValues();
+  int rank = 0;
+  for (Eigen::Index i = 0; i < s.size(); ++i)
+    if (s(i) > rank_tolerance * s(0)) ++rank;
+  AugmentedImpedance out;
+  out.N = svd.matrixV().rightCols(J.cols() - rank);
+  // J_int = (Nᵀ K N)⁻¹ Nᵀ K with K = b_a (2.39)
+  const MatrixX NtK = out.N.transpose() * b_a_diag.asDiagonal();
+  const MatrixX NtKN = NtK * out.N;
+  out.J_int = NtKN.llt().solve(NtK);
+  return out;
+}
+
+}  // namespace mannequin::control

@@ -1,0 +1,60 @@
+// The control step allocates nothing after construction: the three stages with a constraint force,
+// two priority levels, the internal control and an enabled virtual mechanism. malloc is
+// interposed, so this runs only without AddressSanitizer (which owns malloc).
+#include <gtest/gtest.h>
+
+#include <cstddef>
+
+#include "common.hpp"
+
+#if !defined(__SANITIZE_ADDRESS__)
+namespace {
+long g_allocations = 0;
+bool g_counting = false;
+}  // namespace
+extern "C" void* __libc_malloc(std::size_t size);
+extern "C" void* malloc(std::size_t size) {
+  if (g_counting) ++g_allocations;
+  return __libc_malloc(size);
+}
+#endif
+
+using namespace mannequin;
+using namespace mannequin::control;
+using namespace mannequin::control::testing;
+
+TEST(ControlAlloc, StepAllocatesNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "malloc is owned by AddressSanitizer";
+#else
+  for (ProjectorMethod method : {ProjectorMethod::kLdlt, ProjectorMethod::kSvd}) {
+    ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+    c.projector = method;
+    Controller ctl(male50(), c);
+    const int h = ctl.frameIndex("hand_r");
+    MechanismConfig m;
+    m.spec.type = MechanismType::kSlidingPivot;
+    m.spec.base = ctl.frame(h).pose;
+    m.stiffness = gains(1000, 10000);
+    m.damping = gains(10, 100);
+    m.enabled = true;
+    ctl.attachMechanism(h, m);
+    VectorX gamma_c = VectorX::Zero(ctl.model().nv);
+    gamma_c(2) = 10.0;
+    SE3 target = ctl.frame(ctl.frameIndex("hand_l")).pose;
+    ctl.step();  // warm-up
+    g_allocations = 0;
+    g_counting = true;
+    for (int i = 0; i < 50; ++i) {
+      target.p.x() += 1e-4;
+      ctl.setTarget(ctl.frameIndex("hand_l"), target);
+      ctl.computeFreeMotion();
+      ctl.applyConstraintForce(gamma_c);
+      ctl.integrate();
+      ctl.step();
+    }
+    g_counting = false;
+    EXPECT_EQ(g_allocations, 0) << toString(method);
+  }
+#endif
+}

@@ -1,0 +1,296 @@
+// The controller on the male_50th mannequin: Jacobians, b (2.17), the constraint hook (Alg. 4),
+// door-handle reach (Fig. 2.6), conflicting tasks by weights and priorities (Fig. 2.11, 2.13,
+// 2.14), gravity and the internal potential (Fig. 4.2), bad input.
+#include <gtest/gtest.h>
+
+#include <random>
+
+#include "common.hpp"
+
+using namespace mannequin;
+using namespace mannequin::control;
+using namespace mannequin::control::testing;
+
+namespace {
+// posture error over the internal coordinates: ‖q_d ⊖ q‖ without the root
+double postureError(const skeleton::Model& model, const VectorX& q, const VectorX& q_d) {
+  VectorX d(model.nv);
+  differenceInPlace(model, q, q_d, d);
+  return d.tail(model.nv - 6).norm();
+}
+}  // namespace
+
+TEST(Controller, DefaultConfigBuildsAndHoldsThePostureWithoutGravity) {
+  ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+  c.gravity.setZero();
+  Controller ctl(male50(), c);
+  ASSERT_EQ(ctl.numFrames(), 6);
+  const VectorX q0 = ctl.q();
+  for (int i = 0; i < 100; ++i) ASSERT_EQ(ctl.step(), StepStatus::kOk);
+  EXPECT_LT((ctl.q() - q0).cwiseAbs().maxCoeff(), 1e-9);  // targets at the current poses: equilibrium
+  for (const auto& e : ctl.checkStability()) EXPECT_LT(e.ratio, 1.0) << e.what;
+}
+
+TEST(Controller, ControlFrameJacobianMatchesFiniteDifferences) {
+  // body Jacobian of a control frame with an offset: V = J q̇ with e = log(oMc(q)⁻¹ oMc(q ⊕ εe_k))/ε
+  const auto& model = male50();
+  ControllerConfig c = baseConfig();
+  ControlFrameConfig hand = frameConfig("hand_r", 0, 10, 100);
+  hand.offset = SE3(rotation(Vector3(0.3, -0.5, 0.2)), Vector3(0.02, -0.01, -0.09));
+  c.frames = {hand, frameConfig("foot_l", 1, 10, 100)};
+  std::mt19937 rng(4);
+  std::uniform_real_distribution<double> u(-0.6, 0.6);
+  VectorX q(model.nq);
+  for (int i = 0; i < model.nq; ++i) q(i) = u(rng);
+  Controller ctl(model, c, q);
+  ctl.computeFreeMotion();
+  const int h = ctl.frameIndex("hand_r");
+  const MatrixX J = ctl.taskJacobian().middleRows(ctl.frameRow(h), 6);
+  skeleton::Data data(model);
+  const auto pose = [&](const VectorX& qq) {
+    skeleton::forwardKinematics(model, data, qq);
+    return data.oMf[model.frameIndex("hand_r")] * hand.offset;
+  };
+  const SE3 H0 = pose(q);
+  EXPECT_TRUE(H0.isApprox(ctl.frame(h).pose, 1e-12));
+  const double eps = 1e-7;
+  for (int k = 0; k < model.nv; ++k) {
+    VectorX v = VectorX::Zero(model.nv);
+    v(k) = eps;
+    const Vector6 fd = math::logSE3(H0.inverse() * pose(skeleton::integrate(model, q, v))) / eps;
+    EXPECT_LT((fd - J.col(k)).norm(), 1e-5) << "column " << k;
+  }
+}
+
+TEST(Controller, ApparentFrictionIsBaPlusJtBcJ) {
+  // b = b_a + Σ Jᵀ b_c J (2.17), symmetric positive definite
+  ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+  Controller ctl(male50(), c);
+  ctl.computeFreeMotion();
+  MatrixX b = ctl.frictionDiagonal().asDiagonal();
+  for (int i = 0; i < ctl.numFrames(); ++i) {
+    const MatrixX Ji = ctl.taskJacobian().middleRows(ctl.frameRow(i), 6);
+    b += Ji.transpose() * ctl.frame(i).damping.asDiagonal() * Ji;
+  }
+  EXPECT_LT((b - ctl.apparentFriction()).norm() / b.norm(), 1e-14);
+  EXPECT_EQ(ctl.apparentFrictionLLT().info(), Eigen::Success);
+  // q̇_free = b⁻¹Γ
+  const VectorX gamma = ctl.taskTorque() + ctl.internalTorque() + ctl.gravityTorque();
+  EXPECT_LT((b * ctl.qdotFree() - gamma).norm(), 1e-9 * (1 + gamma.norm()));
+}
+
+TEST(Controller, ConstraintHookAddsBInverseJcTWcThenIntegratesOnTheManifold) {
+  const auto& model = male50();
+  ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+  Controller ctl(model, c);
+  ctl.step();
+  const VectorX q0 = ctl.q();
+  ASSERT_EQ(ctl.computeFreeMotion(), StepStatus::kOk);
+  // a contact-like force: W_c = 50 N up on the left sole point, Γ_c = J_cᵀW_c (3.7)
+  Eigen::Matrix3Xd Jc;
+  skeleton::pointJacobian(model, ctl.data(), model.frames[model.frameIndex("sole_l")].joint,
+                          model.frames[model.frameIndex("sole_l")].placement.p, Jc);
+  const VectorX gamma_c = Jc.transpose() * Vector3(0, 0, 50);
+  ctl.applyConstraintForce(gamma_c);
+  const VectorX expected = ctl.qdotFree() + ctl.apparentFriction().ldlt().solve(gamma_c);
+  EXPECT_LT((ctl.qdot() - expected).norm(), 1e-10 * (1 + expected.norm()));
+  // the sole moves up relative to the free motion
+  EXPECT_GT((Jc * (ctl.qdot() - ctl.qdotFree()))(2), 0.0);
+  const VectorX qdot = ctl.qdot();
+  ctl.integrate();
+  EXPECT_LT((ctl.q() - skeleton::integrate(model, q0, qdot, c.dt)).cwiseAbs().maxCoeff(), 1e-14);
+  EXPECT_NEAR(ctl.constraintPort().power, gamma_c.dot(qdot), 1e-12);  // Γ_cᵀq̇ at the constraint port
+  EXPECT_THROW(ctl.applyConstraintForce(gamma_c), std::invalid_argument);  // stage 1 not run
+}
+
+TEST(Controller, DoorHandleReachConvergesMonotonically) {
+  // Fig. 2.6: the target follows a trajectory to the door handle, the hand's PD coupling follows it;
+  // once the target stops, the error decays monotonically (free case: no conflict, no weight)
+  const auto& model = male50();
+  ControllerConfig c = baseConfig();
+  c.frames = {frameConfig("foot_l", 0, 2000, 20000), frameConfig("foot_r", 0, 2000, 20000),
+              frameConfig("hand_r", 1, 100, 2000)};
+  Controller ctl(model, c);
+  const int h = ctl.frameIndex("hand_r");
+  const SE3 start = ctl.frame(h).pose;
+  // the handle: 30 cm forward, 15 cm up, hand pitched forward by 60°
+  const SE3 handle(rotation(Vector3(0, -60.0 * M_PI / 180, 0)) * start.R, start.p + Vector3(0.30, -0.05, 0.15));
+  const int approach = 500, hold = 2500;
+  for (int i = 1; i <= approach; ++i) {
+    ctl.setTarget(h, math::interpolate(start, handle, static_cast<double>(i) / approach));
+    ASSERT_EQ(ctl.step(), StepStatus::kOk);
+  }
+  ctl.computeFreeMotion();
+  double prev = ctl.frame(h).error.norm();
+  const double after_approach = prev;
+  int increases = 0;
+  for (int i = 0; i < hold; ++i) {
+    ASSERT_EQ(ctl.step(), StepStatus::kOk);
+    ctl.computeFreeMotion();
+    const double e = ctl.frame(h).error.norm();
+    if (e > prev + 1e-12) ++increases;
+    prev = e;
+  }
+  EXPECT_EQ(increases, 0);
+  EXPECT_GT(after_approach, 1e-3);  // there was something left to converge
+  EXPECT_LT(ctl.frame(h).positionError(), 1e-4);
+  EXPECT_LT(ctl.frame(h).rotationError(), 1e-3);
+  // feet held
+  EXPECT_LT(ctl.frame(ctl.frameIndex("foot_l")).positionError(), 1e-4);
+}
+
+namespace {
+struct ConflictResult {
+  double foot, hand, hand_null_force, hand_force;
+};
+ConflictResult runConflict(bool priorities) {
+  // Fig. 2.11: the feet hold their standing poses, the right hand is asked 2.5 m in front at
+  // 1.2 m height, farther than the stretched body reaches: not both reachable
+  const auto& model = male50();
+  ControllerConfig c = baseConfig();
+  c.frames = {frameConfig("foot_l", 0, 2000, 20000), frameConfig("foot_r", 0, 2000, 20000),
+              frameConfig("hand_r", priorities ? 1 : 0, 100, 2000)};
+  c.frames[2].stiffness.head<3>().setZero();  // position only for the hand
+  c.frames[2].damping.head<3>().setZero();
+  Controller ctl(model, c);
+  const int h = ctl.frameIndex("hand_r"), fl = ctl.frameIndex("foot_l"), fr = ctl.frameIndex("foot_r");
+  SE3 target = ctl.frame(h).pose;
+  target.p = Vector3(2.5, -0.2, 1.2);
+  ctl.setTarget(h, target);
+  for (int i = 0; i < 3000; ++i) ctl.step();
+  ctl.computeFreeMotion();
+  ConflictResult r;
+  r.foot = std::max(ctl.frame(fl).error.norm(), ctl.frame(fr).error.norm());
+  r.hand = ctl.frame(h).positionError();
+  // optimality of the lower task: its torque has no component left in the feet's null space
+  const MatrixX& J = ctl.taskJacobian();
+  const MatrixX Jh = J.middleRows(ctl.frameRow(h), 6);
+  const VectorX gamma_h = Jh.transpose() * ctl.frame(h).stiffness.cwiseProduct(ctl.frame(h).error);
+  MatrixX Jfeet(12, model.nv);
+  Jfeet << J.middleRows(ctl.frameRow(fl), 6), J.middleRows(ctl.frameRow(fr), 6);
+  WeightedNullSpace feet(12, model.nv, ProjectorMethod::kSvd, 1e-9);
+  feet.compute(Jfeet, ctl.frictionDiagonal().cwiseInverse());
+  VectorX projected(model.nv);
+  feet.projectTorque(gamma_h, projected);
+  r.hand_null_force = projected.norm();
+  r.hand_force = gamma_h.norm();
+  return r;
+}
+}  // namespace
+
+TEST(Controller, ConflictingTasksWeightedNeitherIsMet) {
+  // Fig. 2.13: weighting (same level, different stiffnesses): a compromise, no task met
+  const ConflictResult w = runConflict(false);
+  EXPECT_GT(w.foot, 0.01);
+  EXPECT_GT(w.hand, 0.01);
+}
+
+TEST(Controller, ConflictingTasksPrioritisedTopIsMetLowerAsCloseAsPossible) {
+  // Fig. 2.14: the feet (top) are met, the hand is as close as it can be without moving them
+  const ConflictResult w = runConflict(false);
+  const ConflictResult p = runConflict(true);
+  EXPECT_LT(p.foot, 1e-4);
+  EXPECT_GT(p.hand, w.hand);  // the hand no longer drags the feet along
+  EXPECT_LT(p.hand_null_force, 1e-3 * p.hand_force);
+}
+
+namespace {
+double sag(bool gravity, bool internal) {
+  // Fig. 4.2: hands and feet held at their standing poses (4 control frames, as in 2.2.1.4)
+  const auto& model = male50();
+  ControllerConfig c = baseConfig();
+  if (gravity) c.gravity = Vector3(0, 0, -9.81);
+  c.internal.enabled = internal;
+  c.internal.stiffness = 400;
+  c.frames = {frameConfig("foot_l", 0, 2000, 20000), frameConfig("foot_r", 0, 2000, 20000),
+              frameConfig("hand_l", 0, 100, 2000), frameConfig("hand_r", 0, 100, 2000)};
+  Controller ctl(model, c);
+  const VectorX q_d = ctl.posture();
+  for (int i = 0; i < 2000; ++i) ctl.step();
+  return postureError(model, ctl.q(), q_d);
+}
+}  // namespace
+
+TEST(Controller, GravitySagsTheMannequinAndTheInternalPotentialRestoresIt) {
+  const double none = sag(false, false), slumped = sag(true, false), restored = sag(true, true);
+  EXPECT_LT(none, 1e-9);       // a) without weight
+  EXPECT_GT(slumped, 0.3);     // b) with weight the body slumps (rad, all internal coordinates)
+  EXPECT_LT(restored, 0.25 * slumped);  // c) the internal potential gives back the posture
+}
+
+TEST(Controller, NaNTargetIsRejectedAndTheStateKept) {
+  ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+  Controller a(male50(), c), b(male50(), c);
+  const int h = a.frameIndex("hand_l");
+  SE3 good = a.frame(h).pose;
+  good.p.x() += 0.05;
+  a.setTarget(h, good);
+  b.setTarget(h, good);
+  SE3 bad = good;
+  bad.p.y() = std::nan("");
+  try {
+    a.setTarget(h, bad);
+    FAIL() << "NaN target accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("hand_l"), std::string::npos) << e.what();
+  }
+  Vector6 twist = Vector6::Zero();
+  twist(2) = std::numeric_limits<double>::infinity();
+  EXPECT_THROW(a.setTarget(h, good, twist), std::invalid_argument);
+  SE3 skew = good;
+  skew.R(0, 1) += 0.3;
+  EXPECT_THROW(a.setTarget(h, skew), std::invalid_argument);
+  for (int i = 0; i < 50; ++i) {
+    a.step();
+    b.step();
+  }
+  EXPECT_EQ((a.q() - b.q()).cwiseAbs().maxCoeff(), 0.0);  // same as if the bad call never happened
+  EXPECT_TRUE(a.frame(h).target.isApprox(good));
+  VectorX nan_q = a.q();
+  nan_q(10) = std::nan("");
+  EXPECT_THROW(a.setPosture(nan_q), std::invalid_argument);
+  EXPECT_THROW(a.reset(nan_q), std::invalid_argument);
+  EXPECT_THROW(a.frameIndex("hand_x"), std::invalid_argument);
+  EXPECT_THROW(a.setTarget(17, good), std::invalid_argument);
+  EXPECT_THROW(a.mechanism(h), std::invalid_argument);
+}
+
+TEST(Controller, UnknownNamesAndInconsistentConfigsGiveClearErrors) {
+  const auto& model = male50();
+  const auto message = [&](const ControllerConfig& c) {
+    try {
+      Controller ctl(model, c);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  ControllerConfig c = parseControllerConfig(
+      "control_frames:\n  - name: grip\n    frame: handx\n    stiffness: [1, 1, 1, 10, 10, 10]\n", "test.yaml");
+  std::string m = message(c);
+  EXPECT_NE(m.find("test.yaml:2"), std::string::npos) << m;
+  EXPECT_NE(m.find("'handx'"), std::string::npos) << m;
+  EXPECT_NE(m.find("hand_r"), std::string::npos) << m;  // lists the valid frames
+
+  c = baseConfig();
+  c.b_a.coordinates["kneee_l"] = 3;
+  m = message(c);
+  EXPECT_NE(m.find("kneee_l"), std::string::npos) << m;
+  EXPECT_NE(m.find("knee_l"), std::string::npos) << m;
+
+  c = baseConfig();
+  c.frames = {frameConfig("hand_r", 0, 1, 1), frameConfig("hand_r", 1, 1, 1)};
+  EXPECT_NE(message(c).find("duplicate"), std::string::npos);
+  c = baseConfig();
+  c.frames = {frameConfig("hand_r", 0, 1, 1)};
+  c.frames[0].stiffness(2) = -1;
+  EXPECT_NE(message(c).find(">= 0"), std::string::npos);
+  c = baseConfig();
+  c.dt = 0;
+  EXPECT_NE(message(c).find("dt_s"), std::string::npos);
+  c = baseConfig();
+  c.b_a.joints = -2;
+  EXPECT_NE(message(c).find("b_a"), std::string::npos);
+  c = baseConfig();
+  EXPECT_THROW(Controller(model, c, VectorX::Zero(5)), std::invalid_argument);
+}
