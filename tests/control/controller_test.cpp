@@ -131,6 +131,8 @@ TEST(Controller, DoorHandleReachConvergesMonotonically) {
     if (e > prev + 1e-12) ++increases;
     prev = e;
   }
+  std::printf("door handle: error %.4f after the approach, %.2e m / %.2e rad after %.1f s more\n", after_approach,
+              ctl.frame(h).positionError(), ctl.frame(h).rotationError(), hold * 1e-3);
   EXPECT_EQ(increases, 0);
   EXPECT_GT(after_approach, 1e-3);  // there was something left to converge
   EXPECT_LT(ctl.frame(h).positionError(), 1e-4);
@@ -189,6 +191,8 @@ TEST(Controller, ConflictingTasksPrioritisedTopIsMetLowerAsCloseAsPossible) {
   // Fig. 2.14: the feet (top) are met, the hand is as close as it can be without moving them
   const ConflictResult w = runConflict(false);
   const ConflictResult p = runConflict(true);
+  std::printf("weighted: foot %.4f m, hand %.3f m; priorities: foot %.2e m, hand %.3f m, null-space force %.2e of %.1f\n",
+              w.foot, w.hand, p.foot, p.hand, p.hand_null_force, p.hand_force);
   EXPECT_LT(p.foot, 1e-4);
   EXPECT_GT(p.hand, w.hand);  // the hand no longer drags the feet along
   EXPECT_LT(p.hand_null_force, 1e-3 * p.hand_force);
@@ -213,6 +217,8 @@ double sag(bool gravity, bool internal) {
 
 TEST(Controller, GravitySagsTheMannequinAndTheInternalPotentialRestoresIt) {
   const double none = sag(false, false), slumped = sag(true, false), restored = sag(true, true);
+  std::printf("posture error (rad): no weight %.2e, weight %.3f, weight + internal potential %.3f\n", none, slumped,
+              restored);
   EXPECT_LT(none, 1e-9);       // a) without weight
   EXPECT_GT(slumped, 0.3);     // b) with weight the body slumps (rad, all internal coordinates)
   EXPECT_LT(restored, 0.25 * slumped);  // c) the internal potential gives back the posture
