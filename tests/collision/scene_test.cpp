@@ -100,7 +100,7 @@ TEST(Scene, MissingAndCorruptMeshFiles) {
   std::string e = sceneError("bodies:\n  - name: a\n    shapes:\n      - {type: mesh, file: nothere.stl}\n", dir);
   EXPECT_NE(e.find("test.yaml:4: bodies[0].shapes[0].file"), std::string::npos) << e;
   EXPECT_NE(e.find(dir + "/nothere.stl: no such mesh file"), std::string::npos) << e;
-  writeText(dir + "/garbage.stl", std::string("\x01\x02\x03 this is not an STL file at all", 40));
+  writeText(dir + "/garbage.stl", std::string(40, '\x01') + " this is not an STL file at all");
   e = sceneError("bodies:\n  - name: a\n    shapes:\n      - {type: mesh, file: garbage.stl}\n", dir);
   EXPECT_NE(e.find("bodies[0].shapes[0].file"), std::string::npos) << e;
   EXPECT_NE(e.find(dir + "/garbage.stl: "), std::string::npos) << e;
