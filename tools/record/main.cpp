@@ -21,13 +21,14 @@ int main(int argc, char** argv) {
   CLI::App app{"mannequin-record: records the cluster's topics into an MCAP file (protobuf schemas, zstd\n"
                "chunks, index and summary). Stops on Ctrl-C/SIGTERM or after --duration; a killed recorder\n"
                "loses at most the last --flush-interval of messages."};
-  std::string deployment, out, topics_arg, compression = "zstd", log_level = "info";
+  std::string deployment, run_dir, out, topics_arg, compression = "zstd", log_level = "info";
   std::vector<std::string> connect;
   double duration = 0, flush_interval = 1.0, progress = 5.0;
   std::uint64_t chunk_size = 1 << 20;
   int zstd_level = 3;
-  app.add_option("deployment", deployment, "deployment file: the recorder connects to every 'publish' endpoint in it")
+  app.add_option("deployment", deployment, "deployment file: the recorder connects to the publish endpoint of every service")
       ->check(CLI::ExistingFile);
+  app.add_option("--run-dir", run_dir, "${RUN_DIR} of the deployment's endpoints (default: as mannequin-launch)");
   app.add_option("--out,-o", out, "MCAP file to write")->required();
   app.add_option("--topics", topics_arg, "comma-separated topics to record (default: every topic)");
   app.add_option("--duration", duration, "stop after this many seconds (0 = until Ctrl-C)")
@@ -56,7 +57,7 @@ int main(int argc, char** argv) {
     const auto& stop = tools::stopOnSignals();
     std::vector<std::string> endpoints = connect;
     if (!deployment.empty()) {
-      for (const std::string& e : tools::publishEndpoints(deployment)) endpoints.push_back(e);
+      for (const std::string& e : tools::publishEndpoints(deployment, run_dir)) endpoints.push_back(e);
     }
     const std::vector<std::string> wanted = tools::splitList(topics_arg);
     const std::set<std::string> wanted_set(wanted.begin(), wanted.end());

@@ -2,7 +2,6 @@
 
 #include <google/protobuf/io/coded_stream.h>
 #include <google/protobuf/wire_format_lite.h>
-#include <yaml-cpp/yaml.h>
 
 #include <algorithm>
 #include <csignal>
@@ -10,42 +9,11 @@
 
 #include <mannequin/v1/header.pb.h>
 
+#include "mannequin/deploy/deployment.hpp"
+
 namespace mannequin::tools {
 
 namespace {
-
-void collect(const YAML::Node& node, const std::string& file, std::vector<std::string>& out) {
-  if (node.IsMap()) {
-    for (const auto& kv : node) {
-      const std::string key = kv.first.IsScalar() ? kv.first.Scalar() : std::string();
-      if (key == "publish") {
-        const YAML::Node& v = kv.second;
-        std::vector<std::string> eps;
-        if (v.IsScalar()) {
-          eps.push_back(v.Scalar());
-        } else if (v.IsSequence()) {
-          for (const auto& e : v) {
-            if (!e.IsScalar()) {
-              throw std::runtime_error(file + ":" + std::to_string(e.Mark().line + 1) +
-                                       ": field 'publish': expected an endpoint string");
-            }
-            eps.push_back(e.Scalar());
-          }
-        } else {
-          throw std::runtime_error(file + ":" + std::to_string(v.Mark().line + 1) +
-                                   ": field 'publish': expected an endpoint or a list of endpoints");
-        }
-        for (const std::string& e : eps) {
-          if (std::find(out.begin(), out.end(), e) == out.end()) out.push_back(e);
-        }
-      } else {
-        collect(kv.second, file, out);
-      }
-    }
-  } else if (node.IsSequence()) {
-    for (const auto& e : node) collect(e, file, out);
-  }
-}
 
 std::atomic<bool> g_stop{false};  // lock-free: safe to set from a signal handler
 
@@ -55,18 +23,23 @@ void onSignal(int) {
 
 }  // namespace
 
-std::vector<std::string> publishEndpoints(const std::string& deployment_file) {
-  YAML::Node root;
-  try {
-    root = YAML::LoadFile(deployment_file);
-  } catch (const YAML::BadFile&) {
-    throw std::runtime_error(deployment_file + ": cannot read the deployment file");
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(deployment_file + ":" + std::to_string(e.mark.line + 1) + ": " + e.msg);
-  }
+std::vector<std::string> publishEndpoints(const std::string& deployment_file, const std::string& run_dir,
+                                          const std::vector<std::string>& names) {
+  const deploy::Deployment d = deploy::loadDeployment(deployment_file, run_dir);
   std::vector<std::string> out;
-  collect(root, deployment_file, out);
-  if (out.empty()) throw std::runtime_error(deployment_file + ": no 'publish' endpoint in the deployment file");
+  if (names.empty()) {
+    for (const deploy::ServiceSpec& s : d.services) out.push_back(s.publish);
+    return out;
+  }
+  for (const std::string& n : names) {
+    try {
+      out.push_back(d.endpointOf(n));
+    } catch (const std::out_of_range&) {
+      std::string all;
+      for (const deploy::ServiceSpec& s : d.services) all += (all.empty() ? "" : ", ") + s.name;
+      throw std::runtime_error(deployment_file + ": no service '" + n + "' (services: " + all + ")");
+    }
+  }
   return out;
 }
 

@@ -10,11 +10,12 @@
 
 namespace mannequin::tools {
 
-/// Every endpoint listed under a key named `publish` anywhere in the deployment YAML file (a
-/// string or a list of strings), in file order, without duplicates. These are where the
-/// services bind their publishers, i.e. what a recorder connects to.
-/// \throws std::runtime_error "FILE:LINE: ..." for unreadable YAML or a bad `publish` value.
-std::vector<std::string> publishEndpoints(const std::string& deployment_file);
+/// Publish endpoints of the deployment file's services (deploy::loadDeployment, ${RUN_DIR}
+/// expanded with run_dir, "" = the file's default): `names` empty = every service, else the named
+/// ones. \throws service::ConfigError "FILE:LINE: ..." for a bad file, std::runtime_error naming
+/// an unknown service (with the deployment's services).
+std::vector<std::string> publishEndpoints(const std::string& deployment_file, const std::string& run_dir,
+                                          const std::vector<std::string>& names = {});
 
 /// Header fields of a raw mannequin.v1 payload (field 1 of every top-level message).
 struct RawHeader {

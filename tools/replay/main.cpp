@@ -47,14 +47,21 @@ void printInfo(const recording::McapReader& r, const std::string& file) {
 int main(int argc, char** argv) {
   CLI::App app{"mannequin-replay: publishes an MCAP recording onto the cluster. Keys (when stdin is a terminal):\n"
                "space = pause/resume, n or s = step one message, q = quit."};
-  std::string file, topics_arg, lockstep_after = "mocap.frame", ack_topic, log_level = "info";
+  std::string ack_rule = "any";
+  std::string file, deployment, run_dir, as_services, ack_from, topics_arg, lockstep_after = "mocap.frame", ack_topic, log_level = "info";
   std::vector<std::string> publish, ack_connect;
+  double linger = 1.0;
   double rate = 1.0, start = 0, end = -1, ack_timeout = 2.0, wait_subscribers = 1.0, progress = 5.0;
   bool loop = false, paused = false, no_keys = false, info = false, fast = false;
   std::uint64_t max_loops = 0, ack_every = 1;
   app.add_option("file", file, "MCAP recording")->required()->check(CLI::ExistingFile);
   app.add_option("--publish", publish, "endpoint to bind the replay publisher to (repeatable): where the consumers "
                                        "expect the publisher that the replay stands in for");
+  app.add_option("--deployment", deployment, "deployment file: with --as, publish where those services would")
+      ->check(CLI::ExistingFile);
+  app.add_option("--as", as_services, "comma-separated services of --deployment the replay stands in for (they must "
+                                      "not be running): binds their publish endpoints");
+  app.add_option("--run-dir", run_dir, "${RUN_DIR} of the deployment's endpoints (default: as mannequin-launch)");
   app.add_option("--rate", rate, "rate factor of the original timing (2 = twice as fast)")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_flag("--fast", fast, "ignore timing: publish as fast as possible");
@@ -67,16 +74,23 @@ int main(int argc, char** argv) {
   app.add_option("--topics", topics_arg, "comma-separated topics to replay (default: all)");
   app.add_flag("--paused", paused, "start paused (space or n to go on)");
   app.add_flag("--no-keys", no_keys, "do not read keys from the terminal");
-  app.add_option("--lockstep", ack_topic, "lockstep: after each --lockstep-after message, wait for a message on this "
-                                          "topic (from --ack-connect) whose header stamp_ns reaches the replayed one");
+  app.add_option("--lockstep", ack_topic, "lockstep: after each --lockstep-after message, wait for the consumer's ack: "
+                                          "a message on this topic (from --ack-connect / --ack-from), see --ack-rule");
+  app.add_option("--ack-rule", ack_rule, "any: any new ack-topic message acknowledges; stamp: one whose Header.stamp_ns "
+                                         "reaches the replayed message's (consumers that keep the input clock)")
+      ->check(CLI::IsMember({"any", "stamp"}))->capture_default_str();
   app.add_option("--lockstep-after", lockstep_after, "comma-separated topics that wait for the consumer's ack")
       ->capture_default_str();
   app.add_option("--ack-connect", ack_connect, "endpoint of the consumer's publisher (repeatable)");
+  app.add_option("--ack-from", ack_from, "with --deployment: the consumer service whose endpoint gives the acks");
   app.add_option("--ack-every", ack_every, "wait for an ack after every N-th --lockstep-after message")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--ack-timeout", ack_timeout, "seconds to wait for an ack before going on (counted, warned)")
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--wait-subscribers", wait_subscribers, "wait up to this many seconds for a first subscriber")
+      ->check(CLI::NonNegativeNumber)->capture_default_str();
+  app.add_option("--linger", linger, "seconds to keep the publisher open after the last message, so that queued "
+                                     "messages reach slow subscribers")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_flag("--info", info, "print what the file holds and exit");
   app.add_option("--progress", progress, "log progress every this many seconds (0 = never)")
@@ -84,8 +98,15 @@ int main(int argc, char** argv) {
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")->capture_default_str();
   try {
     app.parse(argc, argv);
-    if (!info && publish.empty()) throw CLI::ValidationError("--publish ENDPOINT is required (unless --info)");
-    if (!ack_topic.empty() && ack_connect.empty()) throw CLI::ValidationError("--lockstep needs --ack-connect ENDPOINT");
+    if ((!as_services.empty() || !ack_from.empty()) && deployment.empty()) {
+      throw CLI::ValidationError("--as and --ack-from need --deployment FILE");
+    }
+    if (!info && publish.empty() && as_services.empty()) {
+      throw CLI::ValidationError("give --publish ENDPOINT or --deployment FILE --as SERVICE (unless --info)");
+    }
+    if (!ack_topic.empty() && ack_connect.empty() && ack_from.empty()) {
+      throw CLI::ValidationError("--lockstep needs --ack-connect ENDPOINT or --ack-from SERVICE");
+    }
     if (end >= 0 && end < start) throw CLI::ValidationError("--end is before --start");
   } catch (const CLI::ParseError& e) {
     const int code = app.exit(e);
@@ -115,6 +136,12 @@ int main(int argc, char** argv) {
     if (end >= 0) po.filter.end = t0 + static_cast<recording::Timestamp>(end * 1e9);
     recording::Player player(reader, po);  // validates topics and rate
 
+    if (!as_services.empty()) {
+      for (const std::string& e : tools::publishEndpoints(deployment, run_dir, tools::splitList(as_services))) publish.push_back(e);
+    }
+    if (!ack_from.empty()) {
+      for (const std::string& e : tools::publishEndpoints(deployment, run_dir, {ack_from})) ack_connect.push_back(e);
+    }
     const auto& stop = tools::stopOnSignals();
     zmq::context_t context;
     transport::Publisher pub(context, {"replay", publish});
@@ -124,6 +151,7 @@ int main(int argc, char** argv) {
     // lockstep acks
     std::unique_ptr<transport::Subscriber> acks;
     std::int64_t acked_stamp = std::numeric_limits<std::int64_t>::min();
+    std::uint64_t acks_received = 0;
     std::uint64_t ack_timeouts = 0, waited = 0, gated = 0;
     const std::vector<std::string> after_list = tools::splitList(lockstep_after);
     const std::set<std::string> after(after_list.begin(), after_list.end());
@@ -131,6 +159,7 @@ int main(int argc, char** argv) {
       acks = std::make_unique<transport::Subscriber>(context, transport::SubscriberOptions{"replay-ack", ack_connect});
       acks->subscribeRaw(ack_topic, [&](std::string_view topic, std::string_view payload, const transport::Received&) {
         if (topic != ack_topic) return;
+        ++acks_received;
         if (const auto h = tools::parseHeader(payload)) acked_stamp = std::max(acked_stamp, h->stamp_ns);
       });
     }
@@ -150,19 +179,24 @@ int main(int argc, char** argv) {
     auto last_progress = std::chrono::steady_clock::now();
     std::uint64_t count = 0;
     const recording::PlayerStats result = player.run(control, [&](const recording::Message& m, const recording::Channel& c) {
+      const bool gate = acks && after.count(c.topic) > 0 && (++gated % ack_every) == 0;
+      if (gate) acks->poll(std::chrono::microseconds(0));  // acks of earlier messages do not count
+      const std::uint64_t acks_before = acks_received;
       pub.publishRaw(c.topic, m.data);
       ++count;
-      if (acks && after.count(c.topic) > 0 && (++gated % ack_every) == 0) {
+      if (gate) {
         const auto h = tools::parseHeader(m.data);
-        if (h) {
+        const bool by_stamp = ack_rule == "stamp";
+        if (h || !by_stamp) {
           ++waited;
+          const std::int64_t want = h ? h->stamp_ns : 0;
           const auto deadline = std::chrono::steady_clock::now() + std::chrono::duration<double>(ack_timeout);
-          while (acked_stamp < h->stamp_ns && !stop.load()) {
+          while ((by_stamp ? acked_stamp < want : acks_received == acks_before) && !stop.load()) {
             acks->poll(std::chrono::milliseconds(5));
             pub.poll();
             if (std::chrono::steady_clock::now() > deadline) {
               ++ack_timeouts;
-              spdlog::warn("lockstep: no '{}' with stamp >= {} ns within {} s; going on", ack_topic, h->stamp_ns, ack_timeout);
+              spdlog::warn("lockstep: no ack on '{}' for message {} within {} s; going on", ack_topic, count, ack_timeout);
               break;
             }
           }
@@ -175,6 +209,12 @@ int main(int argc, char** argv) {
         last_progress = now;
       }
     });
+    // the transport closes sockets without linger: give queued messages time to leave
+    const auto linger_end = std::chrono::steady_clock::now() + std::chrono::duration<double>(result.quit ? 0.0 : linger);
+    while (std::chrono::steady_clock::now() < linger_end && !stop.load()) {
+      pub.poll();
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
     spdlog::info("done: {} messages published, {} pass(es){}{}", result.published, result.passes,
                  result.quit ? ", stopped by the user" : "",
                  acks ? fmt::format(", lockstep: {} waits, {} timeouts", waited, ack_timeouts) : std::string());
