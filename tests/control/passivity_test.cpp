@@ -204,8 +204,10 @@ TEST(Passivity, EnergyObserverBoundsTheEnergyOfTheProjectedPotential) {
   const double last_drop = with.cycle_end_energy[cycles - 2] - with.cycle_end_energy[cycles - 1];
   EXPECT_LT(last_drop, 0.01 * first_drop);  // the drift has stopped
   EXPECT_LT(with.final_alpha, 0.05);
-  EXPECT_GT(with.min_energy, -U0);          // back within the passive bound
-  EXPECT_LT(without.min_energy, -U0);
+  // E stops just past the passive bound −αU₀ (what was created before α reacted), while without the
+  // observer it keeps falling
+  EXPECT_GT(with.min_energy, -1.05 * U0);
+  EXPECT_LT(without.min_energy, -1.5 * U0);
 }
 
 TEST(Passivity, ObserverIsQuietForATruePotential) {
@@ -223,7 +225,8 @@ TEST(Passivity, ObserverIsQuietForATruePotential) {
     x += f * dt;
   }
   EXPECT_EQ(obs.alpha(), 1.0);
-  EXPECT_LT(std::abs(obs.created()), 1e-12);  // the trapezoidal work is exact for a quadratic U
+  EXPECT_LE(obs.created(), 1e-12);  // gives back at most what it stored (trapezoidal work exact)
+  EXPECT_NEAR(obs.injected(), 0.5 * k * (1.0 - x_prev * x_prev), 1e-9);
 }
 
 TEST(Passivity, MannequinPortEnergiesBalanceWithoutPriorityProjections) {
@@ -255,4 +258,33 @@ TEST(Passivity, MannequinPortEnergiesBalanceWithoutPriorityProjections) {
     }
     EXPECT_GT(ctl.dissipation().energy, 0.0);
   }
+}
+
+TEST(Passivity, MannequinObserverIsQuietInNormalUse) {
+  // default config (6 frames, 2 levels, projected posture control k_int = 400, gravity), both hands
+  // moving 30 cm up and down in circles for 3 s: the posture potential stores up to ~1 kJ (the
+  // tasks bend the elbows by ~1.2 rad) and gives part of it back; it never gives more than it held,
+  // so the observer does not touch α
+  ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+  c.internal.stiffness = 400;
+  Controller ctl(male50(), c);
+  const int hl = ctl.frameIndex("hand_l"), hr = ctl.frameIndex("hand_r");
+  const SE3 l0 = ctl.frame(hl).pose, r0 = ctl.frame(hr).pose;
+  double min_alpha = 1.0, max_u = 0.0;
+  for (int i = 0; i < 3000; ++i) {
+    const double t = i * 1e-3;
+    SE3 l = l0, r = r0;
+    l.p += Vector3(0.15 * std::sin(2 * t), 0.0, 0.15 * (1 - std::cos(2 * t)));
+    r.p += Vector3(0.15 * (1 - std::cos(2 * t)), 0.0, 0.15 * std::sin(2 * t));
+    ctl.setTarget(hl, l);
+    ctl.setTarget(hr, r);
+    ASSERT_EQ(ctl.step(), StepStatus::kOk);
+    min_alpha = std::min(min_alpha, ctl.alpha());
+    max_u = std::max(max_u, ctl.internalPotential());
+  }
+  std::printf("mannequin: max U %.0f J, injected %.2f J, created %.1f J, min alpha %.3f\n", max_u,
+              ctl.energyObserver().injected(), ctl.energyObserver().created(), min_alpha);
+  EXPECT_TRUE(ctl.q().allFinite());
+  EXPECT_EQ(min_alpha, 1.0);
+  EXPECT_LT(ctl.energyObserver().created(), 0.0);
 }

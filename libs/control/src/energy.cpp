@@ -6,15 +6,11 @@
 namespace mannequin::control {
 
 double EnergyObserver::update(double work, double potential, double dt) {
-  if (!has_potential_) {
-    // first call: only the potential's reference
-    potential_ = potential;
-    has_potential_ = true;
-    return alpha_;
-  }
-  // energy created by the internal control beyond its potential αU
-  created_ += work + alpha_ * (potential - potential_);
-  potential_ = potential;
+  // energy given by the internal control beyond the largest energy its potential has held:
+  // a true spring gives back at most α·max U (it cannot give more than it stored)
+  injected_ += work;
+  peak_ = std::max(peak_, alpha_ * potential);
+  created_ = injected_ - peak_;
   if (!options_.enabled) return alpha_;
   if (created_ > options_.budget) {
     alpha_ *= std::exp(-options_.decay_per_s * dt);

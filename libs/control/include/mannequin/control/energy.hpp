@@ -9,14 +9,15 @@
 /// the internal control (Γ_int, q̇), gravity and the constraint forces (Γ, q̇).
 ///
 /// Energy observer. The internal control Γ_int = α Πᵀ(−∂U/∂q)ᵀ (2.21) is passive when it derives
-/// from the potential αU (then Γ_intᵀq̇ = −α dU/dt). The projection breaks this when other ports
-/// appear (2.47, Fig. 2.10c). The observer integrates the energy the internal control creates
-/// beyond its potential,
-///     E_created = Σ_k w_k + α_k (U_{k+1} − U_k)        (0 for a true potential),
-/// with w_k the work of Γ_int over step k by the trapezoidal rule, ½(Γ_k + Γ_{k+1})ᵀ(q_{k+1} ⊖ q_k)
-/// (exact for a quadratic potential, so the Euler discretisation itself is not counted),
-/// and while E_created exceeds a budget it reduces α exponentially (rate decay_per_s); when
-/// E_created is back below half the budget α recovers linearly (recovery_per_s) up to 1.
+/// from the potential αU: then its port (Γ_int, q̇) gives ∫Γ_intᵀq̇ dt = α(U(0) − U(t)) ≤ α max U,
+/// it can only give back energy it has stored. The projection breaks this when other ports appear
+/// (2.47, Fig. 2.10c): cycle after cycle it injects energy. The observer integrates the work of the
+/// internal torque, w_k = ½(Γ_k + Γ_{k+1})ᵀ(q_{k+1} ⊖ q_k) (trapezoidal rule, exact for a quadratic
+/// potential, so the Euler discretisation itself is not counted), and measures
+///     E_created = Σ_k w_k − max_k α_k U(q_k)          (≤ 0 for a true potential),
+/// the energy injected beyond the most the potential ever held. While E_created exceeds a budget it
+/// reduces α exponentially (rate decay_per_s); below half the budget α recovers linearly
+/// (recovery_per_s) up to 1.
 namespace mannequin::control {
 
 /// Work done at one port: power at the last step and its integral.
@@ -44,11 +45,10 @@ class EnergyObserver {
   EnergyObserver() = default;
   explicit EnergyObserver(const EnergyObserverOptions& options) : options_(options) {}
 
-  /// α = 1, E_created = 0, U unknown (the next update only records U).
+  /// α = 1, E_created = 0.
   void reset() {
     alpha_ = 1.0;
-    created_ = 0.0;
-    has_potential_ = false;
+    created_ = injected_ = peak_ = 0.0;
   }
   /// \param work w_k, work of the internal torque over the step just done (J, Γ_int scaled by α),
   /// \param potential U(q) (unscaled) at the configuration the step reached, \param dt the step.
@@ -57,14 +57,15 @@ class EnergyObserver {
 
   double alpha() const { return alpha_; }
   double created() const { return created_; }
+  double injected() const { return injected_; }  ///< Σ w_k (J)
   const EnergyObserverOptions& options() const { return options_; }
 
  private:
   EnergyObserverOptions options_;
   double alpha_ = 1.0;
   double created_ = 0.0;
-  double potential_ = 0.0;
-  bool has_potential_ = false;
+  double injected_ = 0.0;  // Σ w_k
+  double peak_ = 0.0;      // max α U
 };
 
 }  // namespace mannequin::control
