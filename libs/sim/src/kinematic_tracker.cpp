@@ -43,7 +43,10 @@ bool KinematicTracker::step(double dt) {
     e_.segment<6>(6 * i) = w * gains_.task * math::logSE3(data_.oMf[frames_[i]].inverse() * targets_[i]);
   }
   const math::MatrixX Jp = math::dampedPseudoInverse(J_, gains_.damping);
-  const skeleton::VectorX posture = gains_.posture * skeleton::difference(model_, q_, q_posture_);
+  skeleton::VectorX posture = gains_.posture * skeleton::difference(model_, q_, q_posture_);
+  // the root is placed by the tasks only: a posture pull on it would leak through the damped projector
+  for (const skeleton::Joint& j : model_.joints)
+    if (j.type == skeleton::JointType::kFreeFlyer) posture.segment(j.idx_v, j.nv).setZero();
   skeleton::VectorX v = Jp * e_ + posture - Jp * (J_ * posture);
   const double m = v.cwiseAbs().maxCoeff();
   if (m > gains_.max_speed) v *= gains_.max_speed / m;

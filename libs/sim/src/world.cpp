@@ -103,7 +103,20 @@ void World::calibrate(Mannequin& m, const MocapInput& frame) {
         }
       }
   m.tracker->reset(qc);
-  m.tracker->setPosture(qc);
+  if (config_.calibration_fit_steps > 0) {
+    // fit the posture to the bodies' positions first (orientations free), so that the offsets only
+    // hold what differs between the tracker's and the model's frames, not a posture mismatch
+    for (int k = 0; k < config_.calibration_fit_steps; ++k) {
+      for (std::size_t i = 0; i < m.frames.size(); ++i) {
+        math::SE3 T = m.tracker->data().oMf[m.frames[i].frame_index];
+        T.p = find(m.frames[i].body)->pose.p;
+        m.tracker->setTarget(static_cast<int>(i), T, 1.0);
+      }
+      if (!m.tracker->step(config_.step)) break;
+    }
+    m.tracker->reset(m.tracker->q());
+  }
+  m.tracker->setPosture(m.tracker->q());
   const skeleton::Data& d = m.tracker->data();
   for (auto& st : m.frames) {
     const BodyInput* b = find(st.body);

@@ -34,8 +34,10 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
     c.world.occlusion_blend = o->getIn("blend", c.world.occlusion_blend, 0.0, 60.0);
   }
   if (auto o = root.find("calibration")) {
-    o->allowOnly({"needs_flag"});
+    o->allowOnly({"needs_flag", "fit_steps"});
     c.world.calibration_needs_flag = o->get("needs_flag", false);
+    c.world.calibration_fit_steps = o->get("fit_steps", c.world.calibration_fit_steps);
+    if (c.world.calibration_fit_steps < 0) (*o)["fit_steps"].fail("must be >= 0");
   }
   if (auto g = root.find("gains")) {
     g->allowOnly({"task", "posture", "damping", "max_speed"});

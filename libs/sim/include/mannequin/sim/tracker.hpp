@@ -8,7 +8,8 @@
 /// its own axes ((ω, v) order) and J_i its body Jacobian (skeleton::frameJacobian, kLocal),
 ///   q̇ = J_w⁺ (w ∘ k_task e) + (I − J_w⁺ J_w) k_post (q_post ⊖ q),   J_w = [w_i J_i]
 /// with J_w⁺ the damped pseudo-inverse (math::dampedPseudoInverse, λ = damping), q̇ clamped to
-/// max_speed, then q ← clampToLimits(q ⊕ q̇ δt) (skeleton::integrate). w_i ∈ [0, 1] is the task
+/// max_speed, then q ← clampToLimits(q ⊕ q̇ δt) (skeleton::integrate). The posture term leaves the
+/// free-flyer root alone (its components are zero): the tasks place the mannequin in the room. w_i ∈ [0, 1] is the task
 /// weight (occlusion blends it to 0, handing the frame to the posture control).
 #include <string>
 #include <vector>

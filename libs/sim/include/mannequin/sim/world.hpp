@@ -9,7 +9,9 @@
 /// Calibration (thesis Fig. 1.10): at the first frame where every body driving a mannequin is tracked
 /// and (if `calibration_needs_flag`) the frame is flagged as the calibration pose, the mannequin is put
 /// in its calibration configuration q_c (standing, root moved horizontally under the body driving the
-/// root frame) and each control frame f driven by body b keeps the offset bMf = oMb(c)⁻¹ · oMf(q_c);
+/// root frame, then fitted for `calibration_fit_steps` tracker steps so that every control frame's origin
+/// reaches its body's position) and each control frame f driven by body b keeps the offset
+/// bMf = oMb(c)⁻¹ · oMf(q_c); q_c is also the posture target;
 /// afterwards its target is oMd(t) = oMb(t) · bMf (world frame).
 ///
 /// Occlusion policy (per control frame): while its body is untracked the target holds the last
@@ -46,6 +48,9 @@ struct SimConfig {
   double occlusion_hold = 0.3;         ///< s
   double occlusion_blend = 0.5;        ///< s
   bool calibration_needs_flag = false; ///< calibrate only on frames flagged calibration_pose
+  /// Steps of posture fitting at calibration: q_c is first pulled so that every control frame's origin
+  /// reaches its body's position (orientations free), from standing; 0 = use the standing posture as is.
+  int calibration_fit_steps = 0;
   TrackerGains gains;
 };
 
