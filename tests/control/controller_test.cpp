@@ -300,3 +300,19 @@ TEST(Controller, UnknownNamesAndInconsistentConfigsGiveClearErrors) {
   c = baseConfig();
   EXPECT_THROW(Controller(model, c, VectorX::Zero(5)), std::invalid_argument);
 }
+
+TEST(Controller, WithoutControlFramesTheWeightSinksTheRootAtMgOverB) {
+  // hand check of (2.4) with gravity only: b = b_a diagonal, so the root's vertical velocity is
+  // −M g / b_root_linear, here −78.5·9.81/300 = −2.567 m/s
+  ControllerConfig c = baseConfig();
+  c.gravity = Vector3(0, 0, -9.81);
+  c.internal.enabled = false;
+  Controller ctl(male50(), c);
+  ASSERT_EQ(ctl.computeFreeMotion(), StepStatus::kOk);
+  EXPECT_NEAR(ctl.qdot()(5), -male50().totalMass() * 9.81 / 300.0, 1e-9);
+  EXPECT_NEAR(ctl.qdot()(3), 0.0, 1e-12);
+  EXPECT_EQ(ctl.taskJacobian().rows(), 0);
+  ctl.integrate();
+  EXPECT_NEAR(ctl.q()(2) - skeleton::standingConfiguration(male50())(2), -male50().totalMass() * 9.81 / 300.0 * 1e-3, 1e-12);
+  EXPECT_NEAR(ctl.gravityPort().energy, ctl.dissipation().energy, 1e-12);  // the weight's work is dissipated
+}
