@@ -1,0 +1,203 @@
+// bench-transport: the cluster's transport on loopback.
+// - PubSub/<size>/<ipc|tcp>: one message published and received by one subscriber (same thread), i.e.
+//   the one-way latency of a message through ZeroMQ and protobuf framing, per size;
+// - Throughput8: sim.world-sized messages (a real WorldState of the 43-DoF mannequin) to 8 subscribers,
+//   each in its own thread: messages/s delivered to every subscriber;
+// - MocapToWorld: a live sim service in-process (1 ms step, sim.world published at the first step after
+//   each new mocap frame), 10 000 MocapFrames at 1 kHz: latency from a frame's publication to the
+//   reception of the first WorldState computed from it (p50, p99, max, in µs).
+#include <benchmark/benchmark.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <atomic>
+#include <filesystem>
+#include <thread>
+
+#include "mannequin/math/so3.hpp"
+#include "mannequin/simservice/messages.hpp"
+#include "mannequin/simservice/sim_service.hpp"
+#include "mannequin/transport/clock.hpp"
+#include "mannequin/transport/convert.hpp"
+#include "mannequin/transport/publisher.hpp"
+#include "mannequin/transport/subscriber.hpp"
+
+using namespace mannequin;
+namespace topics = transport::topics;
+
+namespace {
+std::string ipcDir() {
+  static const std::string dir = [] {
+    auto p = std::filesystem::temp_directory_path() / ("bench-transport-" + std::to_string(getpid()));
+    std::filesystem::create_directories(p);
+    return p.string();
+  }();
+  return dir;
+}
+
+void waitSubscribed(transport::Publisher& pub, std::uint64_t n) {
+  while (pub.subscriptions() < n) {
+    pub.poll();
+    std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  }
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+}
+
+void PubSub(benchmark::State& state) {
+  const std::size_t size = static_cast<std::size_t>(state.range(0));
+  const bool tcp = state.range(1) == 1;
+  zmq::context_t ctx;
+  transport::Publisher pub(ctx, {"bench", {tcp ? "tcp://127.0.0.1:0" : "ipc://" + ipcDir() + "/pubsub"}});
+  transport::Subscriber sub(ctx, {"bench", {pub.boundEndpoints()[0]}});
+  int got = 0;
+  sub.subscribeRaw("bench", [&](std::string_view, std::string_view, const transport::Received&) { ++got; });
+  waitSubscribed(pub, 1);
+  const std::string payload(size, 'x');
+  for (auto _ : state) {
+    const int before = got;
+    pub.publishRaw("bench.payload", payload);
+    while (got == before) sub.poll(std::chrono::microseconds(0));
+  }
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations() * size));
+  state.SetLabel(tcp ? "tcp loopback" : "ipc");
+}
+BENCHMARK(PubSub)->ArgsProduct({{64, 2048, 16384}, {0, 1}})->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+// a WorldState as the sim publishes it (43-DoF mannequin, 6 control frames, a few contacts)
+std::string worldPayload() {
+  v1::WorldState w;
+  w.set_step(1000);
+  auto* m = w.add_mannequins();
+  m->set_name("operator");
+  for (int k = 0; k < 43; ++k) m->add_q(0.1 * k), m->add_v(0.01 * k);
+  for (int s = 0; s < 18; ++s) {
+    auto* np = m->add_segments();
+    np->set_name("segment" + std::to_string(s));
+    transport::toMsg(math::SE3(), *np->mutable_pose());
+  }
+  for (int f = 0; f < 6; ++f) {
+    auto* c = m->add_control_frames();
+    c->set_frame("frame" + std::to_string(f));
+    transport::toMsg(math::SE3(), *c->mutable_target());
+    transport::toMsg(math::SE3(), *c->mutable_actual());
+  }
+  for (int k = 0; k < 8; ++k) m->add_contacts()->set_distance(0.01);
+  return w.SerializeAsString();
+}
+
+void Throughput8(benchmark::State& state) {
+  constexpr int kSubs = 8;
+  zmq::context_t ctx(2);
+  transport::PublisherOptions po{"sim", {"ipc://" + ipcDir() + "/throughput"}};
+  po.send_hwm = 100000;
+  transport::Publisher pub(ctx, po);
+  std::atomic<bool> done{false};
+  std::vector<std::atomic<std::uint64_t>> counts(kSubs);
+  std::vector<std::thread> threads;
+  for (int i = 0; i < kSubs; ++i)
+    threads.emplace_back([&, i] {
+      transport::SubscriberOptions so{"sub" + std::to_string(i), {po.endpoints[0]}};
+      so.receive_hwm = 100000;
+      transport::Subscriber sub(ctx, so);
+      sub.subscribeRaw("sim.world", [&](std::string_view, std::string_view, const transport::Received&) { ++counts[i]; });
+      while (!done.load()) sub.poll(std::chrono::milliseconds(1));
+    });
+  waitSubscribed(pub, kSubs);
+  const std::string payload = worldPayload();
+  std::uint64_t sent = 0;
+  const std::int64_t t0 = transport::steadyNs();
+  for (auto _ : state) {
+    pub.publishRaw("sim.world", payload);
+    ++sent;
+  }
+  // wait until every subscriber has everything (or 10 s)
+  auto minCount = [&] {
+    std::uint64_t m = ~0ull;
+    for (auto& c : counts) m = std::min<std::uint64_t>(m, c.load());
+    return m;
+  };
+  while (minCount() < sent && (transport::steadyNs() - t0) < 10'000'000'000LL) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+  const double seconds = (transport::steadyNs() - t0) * 1e-9;
+  done = true;
+  for (auto& t : threads) t.join();
+  state.counters["msg_per_s_per_subscriber"] = static_cast<double>(minCount()) / seconds;
+  state.counters["delivered_fraction"] = static_cast<double>(minCount()) / static_cast<double>(sent);
+  state.counters["payload_bytes"] = static_cast<double>(payload.size());
+}
+BENCHMARK(Throughput8)->Iterations(50000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+void MocapToWorld(benchmark::State& state) {
+  const int frames = static_cast<int>(state.range(0));
+  for (auto _ : state) {
+    zmq::context_t ctx;
+    const std::string dir = ipcDir();
+    transport::Publisher mocap(ctx, {"mocap", {"ipc://" + dir + "/m2w-mocap"}});
+    simservice::SimServiceConfig cfg = simservice::loadSimConfig("configs/sim/sim_demo.yaml");
+    cfg.mode = simservice::Mode::kLive;
+    cfg.publish = {"ipc://" + dir + "/m2w-sim"};
+    cfg.connect = {"ipc://" + dir + "/m2w-mocap"};
+    cfg.collision.mode = simservice::CollisionMode::kNone;
+    cfg.publish_on_mocap = true;
+    cfg.world.interpolation_delay = 0.0;
+    simservice::SimService sim(cfg, ctx);
+    std::atomic<bool> stop{false};
+    std::thread runner([&] { sim.run(stop); });
+    transport::SubscriberOptions so{"bench", {"ipc://" + dir + "/m2w-sim"}};
+    transport::Subscriber out(ctx, so);
+    std::vector<std::int64_t> sent(frames + 1, 0);
+    std::vector<double> latency_us;
+    latency_us.reserve(frames);
+    std::uint64_t last_seq = 0;
+    out.subscribe(topics::kSimWorld, std::function<void(const v1::WorldState&, const transport::Received&)>(
+                                         [&](const v1::WorldState& w, const transport::Received& r) {
+                                           const std::uint64_t seq = w.mocap().sequence();
+                                           if (seq <= last_seq || seq >= sent.size()) return;  // not the first state of this frame
+                                           last_seq = seq;
+                                           latency_us.push_back(static_cast<double>(r.receive_time_ns - w.mocap().send_time_ns()) * 1e-3);
+                                         }));
+    waitSubscribed(mocap, 2);
+    bool connected = false;
+    out.subscribe(topics::kHeartbeat, std::function<void(const v1::Heartbeat&)>([&](const v1::Heartbeat&) { connected = true; }));
+    while (!connected) out.poll(std::chrono::milliseconds(5));
+    v1::MocapFrame f;
+    const char* names[] = {"pelvis", "head", "hand_l", "hand_r", "foot_l", "foot_r"};
+    const math::Vector3 at[] = {{0, 0, 0.95}, {0, 0, 1.65}, {0.1, 0.3, 0.9}, {0.1, -0.3, 0.9}, {0, 0.1, 0.08}, {0, -0.1, 0.08}};
+    const std::int64_t start = transport::steadyNs();
+    for (int k = 0; k < frames; ++k) {
+      // 1 kHz: wait for the slot while reading the sim's output
+      const std::int64_t due = start + static_cast<std::int64_t>(k) * 1'000'000;
+      while (transport::steadyNs() < due) out.poll(std::chrono::microseconds(std::max<std::int64_t>(0, (due - transport::steadyNs()) / 1000)));
+      f.Clear();
+      f.mutable_header()->set_stamp_ns(static_cast<std::int64_t>(k) * 1'000'000);
+      f.set_frame_number(k);
+      for (int b = 0; b < 6; ++b) {
+        auto* rb = f.add_bodies();
+        rb->set_name(names[b]);
+        rb->set_tracked(true);
+        rb->set_quality(1);
+        math::SE3 H;
+        H.p = at[b] + math::Vector3(0.05 * std::sin(k * 0.01), 0, 0);
+        transport::toMsg(H, *rb->mutable_pose());
+      }
+      mocap.publish(topics::kMocapFrame, f);
+      sent[f.header().sequence()] = f.header().send_time_ns();
+    }
+    const std::int64_t tail = transport::steadyNs();
+    while (transport::steadyNs() - tail < 200'000'000) out.poll(std::chrono::milliseconds(5));
+    stop = true;
+    runner.join();
+    std::sort(latency_us.begin(), latency_us.end());
+    auto pct = [&](double p) { return latency_us.empty() ? -1.0 : latency_us[static_cast<std::size_t>(p * (latency_us.size() - 1))]; };
+    state.counters["frames"] = frames;
+    state.counters["measured"] = static_cast<double>(latency_us.size());
+    state.counters["p50_us"] = pct(0.5);
+    state.counters["p99_us"] = pct(0.99);
+    state.counters["max_us"] = latency_us.empty() ? -1.0 : latency_us.back();
+    state.counters["sim_overruns"] = static_cast<double>(sim.stats().overruns);
+  }
+}
+BENCHMARK(MocapToWorld)->Arg(10000)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+}  // namespace
+
+BENCHMARK_MAIN();
