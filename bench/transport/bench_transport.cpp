@@ -63,25 +63,13 @@ void PubSub(benchmark::State& state) {
 }
 BENCHMARK(PubSub)->ArgsProduct({{64, 2048, 16384}, {0, 1}})->UseRealTime()->Unit(benchmark::kMicrosecond);
 
-// a WorldState as the sim publishes it (43-DoF mannequin, 6 control frames, a few contacts)
+// a WorldState exactly as the sim publishes it (the demo's 43-DoF mannequin, 6 control frames)
 std::string worldPayload() {
+  const simservice::SimServiceConfig cfg = simservice::loadSimConfig("configs/sim/sim_demo.yaml");
+  sim::World world(simservice::buildMannequins(cfg), cfg.world);
+  world.step();
   v1::WorldState w;
-  w.set_step(1000);
-  auto* m = w.add_mannequins();
-  m->set_name("operator");
-  for (int k = 0; k < 43; ++k) m->add_q(0.1 * k), m->add_v(0.01 * k);
-  for (int s = 0; s < 18; ++s) {
-    auto* np = m->add_segments();
-    np->set_name("segment" + std::to_string(s));
-    transport::toMsg(math::SE3(), *np->mutable_pose());
-  }
-  for (int f = 0; f < 6; ++f) {
-    auto* c = m->add_control_frames();
-    c->set_frame("frame" + std::to_string(f));
-    transport::toMsg(math::SE3(), *c->mutable_target());
-    transport::toMsg(math::SE3(), *c->mutable_actual());
-  }
-  for (int k = 0; k < 8; ++k) m->add_contacts()->set_distance(0.01);
+  simservice::toWorldState(world, nullptr, false, false, w);
   return w.SerializeAsString();
 }
 
