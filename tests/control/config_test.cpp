@@ -47,6 +47,7 @@ internal:
   projection: none
   energy_observer: {enabled: false, budget_J: 2, decay_per_s: 1, recovery_per_s: 0.5, alpha_min: 0.1}
 projector: svd
+coupling_error: se3
 rank_tolerance: 1.0e-7
 control_frames:
   - name: drill
@@ -76,6 +77,7 @@ control_frames:
   EXPECT_EQ(c.internal.projection, InternalProjection::kNone);
   EXPECT_DOUBLE_EQ(c.internal.observer.alpha_min, 0.1);
   EXPECT_EQ(c.projector, ProjectorMethod::kSvd);
+  EXPECT_EQ(c.coupling_error, CouplingError::kSE3);
   ASSERT_EQ(c.frames.size(), 1u);
   const ControlFrameConfig& f = c.frames[0];
   EXPECT_EQ(f.frame, "hand_r");

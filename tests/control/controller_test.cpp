@@ -316,3 +316,26 @@ TEST(Controller, WithoutControlFramesTheWeightSinksTheRootAtMgOverB) {
   EXPECT_NEAR(ctl.q()(2) - skeleton::standingConfiguration(male50())(2), -male50().totalMass() * 9.81 / 300.0 * 1e-3, 1e-12);
   EXPECT_NEAR(ctl.gravityPort().energy, ctl.dissipation().energy, 1e-12);  // the weight's work is dissipated
 }
+
+TEST(Controller, CouplingErrorFormsAgreeToFirstOrderAndBothReach) {
+  // log(H⁻¹H_d) (thesis) and (log(RᵀR_d), Rᵀ(p_d − p)) differ at second order only
+  const SE3 H(rotation(Vector3(0.3, -0.2, 0.5)), Vector3(0.1, 0.2, 0.9));
+  for (double s : {1e-2, 1e-3}) {
+    const SE3 Hd = H * math::expSE3((Vector6() << 0.4, -0.3, 0.2, 0.5, 0.1, -0.6).finished() * s);
+    const Vector6 a = couplingError(H, Hd, CouplingError::kSE3), b = couplingError(H, Hd, CouplingError::kR3SO3);
+    EXPECT_LT((a - b).norm(), 2 * s * s);
+    EXPECT_LT((a - math::logSE3(H.inverse() * Hd)).norm(), 1e-15);
+  }
+  // the door-handle reach converges with the thesis's se(3) error too
+  ControllerConfig c = baseConfig();
+  c.coupling_error = CouplingError::kSE3;
+  c.frames = {frameConfig("foot_l", 0, 2000, 20000), frameConfig("foot_r", 0, 2000, 20000),
+              frameConfig("hand_r", 1, 100, 2000)};
+  Controller ctl(male50(), c);
+  const int h = ctl.frameIndex("hand_r");
+  const SE3 start = ctl.frame(h).pose;
+  ctl.setTarget(h, SE3(rotation(Vector3(0, -0.5, 0)) * start.R, start.p + Vector3(0.2, 0.0, 0.1)));
+  for (int i = 0; i < 3000; ++i) ctl.step();
+  ctl.computeFreeMotion();
+  EXPECT_LT(ctl.frame(h).error.norm(), 1e-6);
+}

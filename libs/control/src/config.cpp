@@ -200,7 +200,8 @@ ControllerConfig parseControllerConfig(const std::string& yaml_text, const std::
   const Reader r{source};
   const YAML::Node root = parseYaml(yaml_text, source);
   if (!root.IsMap()) throw ConfigError(source + ":1: expected a mapping (dt_s, gravity, b_a, internal, control_frames, ...)");
-  r.onlyKeys(root, "config", {"dt_s", "gravity", "b_a", "internal", "projector", "rank_tolerance", "control_frames"});
+  r.onlyKeys(root, "config",
+             {"dt_s", "gravity", "b_a", "internal", "projector", "coupling_error", "rank_tolerance", "control_frames"});
   ControllerConfig c;
   c.source = source;
   if (root["dt_s"]) {
@@ -251,6 +252,12 @@ ControllerConfig parseControllerConfig(const std::string& yaml_text, const std::
     if (p == "ldlt") c.projector = ProjectorMethod::kLdlt;
     else if (p == "svd") c.projector = ProjectorMethod::kSvd;
     else r.fail(root["projector"], "projector", "expected 'ldlt' or 'svd', got '" + p + "'");
+  }
+  if (root["coupling_error"]) {
+    const std::string p = r.string(root["coupling_error"], "coupling_error");
+    if (p == "r3_so3") c.coupling_error = CouplingError::kR3SO3;
+    else if (p == "se3") c.coupling_error = CouplingError::kSE3;
+    else r.fail(root["coupling_error"], "coupling_error", "expected 'r3_so3' or 'se3', got '" + p + "'");
   }
   if (root["rank_tolerance"]) {
     c.rank_tolerance = r.positive(root["rank_tolerance"], "rank_tolerance");

@@ -324,14 +324,14 @@ void Controller::couplingTerms() {
     }
     // target coupling (2.12): spring on e = (log(RᵀR_d), Rᵀ(p_d − p)), feed-forward of the target twist
     const SE3 cMd = f.pose.inverse() * f.target;
-    f.error = couplingError(f.pose, f.target);
+    f.error = couplingError(f.pose, f.target, config_.coupling_error);
     vd_c_[i] = math::actTwist(cMd, f.target_twist);
     Vector6 W = f.stiffness.cwiseProduct(f.error) + f.damping.cwiseProduct(vd_c_[i]);
     Vector6 B = f.damping;
     // virtual mechanism coupling (constrained mode)
     if (f.mechanism_enabled && mechanisms_[i]) {
       const SE3 cMe = f.pose.inverse() * mechanisms_[i]->pose();
-      f.mechanism_error = couplingError(f.pose, mechanisms_[i]->pose());
+      f.mechanism_error = couplingError(f.pose, mechanisms_[i]->pose(), config_.coupling_error);
       ve_c_[i] = math::actTwist(cMe, mechanisms_[i]->twist());
       W += f.mechanism_stiffness.cwiseProduct(f.mechanism_error) + f.mechanism_damping.cwiseProduct(ve_c_[i]);
       B += f.mechanism_damping;

@@ -68,6 +68,7 @@ struct ControllerConfig {
   FrictionConfig b_a;
   InternalConfig internal;
   ProjectorMethod projector = ProjectorMethod::kLdlt;
+  CouplingError coupling_error = CouplingError::kR3SO3;  ///< "r3_so3" (default) or "se3" (log(H⁻¹H_d))
   double rank_tolerance = 1e-9;                      ///< relative, on eigenvalues of J b_a⁻¹ Jᵀ
   std::vector<ControlFrameConfig> frames;
   std::string source;                                ///< file it came from (for messages)

@@ -23,6 +23,10 @@ using math::VectorX;
 /// and monotone (no overshoot) iff it is in (0, 1]. \pre b > 0.
 inline double eulerStabilityRatio(double k, double b, double dt) { return k * dt / b; }
 
+/// How a coupling measures x_d − x (2.12): kR3SO3 (default) as below, kSE3 the thesis's literal
+/// log(H⁻¹H_d) ∈ se(3).
+enum class CouplingError { kR3SO3, kSE3 };
+
 /// Error of a coupling from frame H to frame H_d, in H's axes: e = (log(RᵀR_d), Rᵀ(p_d − p)).
 /// The thesis writes x_d − x as log(H⁻¹H_d) (2.12); this is its R³ × SO(3) form (the split the
 /// thesis keeps for interpolation, 4.1.1): equal to first order, but the translational part pulls
@@ -33,6 +37,10 @@ inline Vector6 couplingError(const SE3& H, const SE3& H_d) {
   e.head<3>() = math::logSO3(H.R.transpose() * H_d.R);
   e.tail<3>() = H.R.transpose() * (H_d.p - H.p);
   return e;
+}
+/// Same, with the chosen form (kSE3: log(H⁻¹H_d)).
+inline Vector6 couplingError(const SE3& H, const SE3& H_d, CouplingError form) {
+  return form == CouplingError::kSE3 ? math::logSE3(H.inverse() * H_d) : couplingError(H, H_d);
 }
 
 /// q ⊕ v·dt on the configuration manifold, written into q_out (no allocation):
