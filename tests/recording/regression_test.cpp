@@ -1,10 +1,14 @@
 // A recording is a test: a mocap stream recorded from mannequin-mocap is replayed into a fresh
-// mannequin-sim in deterministic (replay) mode, twice — once as fast as possible, once in lockstep
-// with the sim — and every sim.world of the second run must be byte-identical to the recorded one
-// of the first (same build: no floating-point tolerance needed, none is used).
+// mannequin-sim + mannequin-collision pair in deterministic (replay) mode, twice — once as fast as
+// possible, once in lockstep with the sim — and every sim.world of the second run must be
+// byte-identical to the recorded one of the first (same build: no floating-point tolerance is
+// needed, none is used).
 //
-// Not covered yet: collision in the loop (mannequin-collision is not in the tree when this was
-// written: the sim runs with `collision: {mode: none}`) and scenario triggers (no scenario service).
+// With collision in the loop the test is DISABLED: mannequin-sim (replay mode) uses in each
+// sim.world whichever collision.contacts set has arrived by then, so the contacts of a world depend
+// on timing (seen: the world of step 17 carried the contacts of step 0 in one run and of step 10 in
+// the other; ~10 of 156 worlds differ). Enable it when the sim waits for the contacts of its query
+// deterministically in replay mode. Not covered: scenario triggers (no scenario service yet).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -18,6 +22,8 @@
 
 #include "mannequin/recording/mcap_reader.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
+#include <google/protobuf/util/message_differencer.h>
+#include <mannequin/v1/world.pb.h>
 #include "test_files.hpp"
 
 namespace fs = std::filesystem;
@@ -62,14 +68,17 @@ int stopAndWait(pid_t pid) {
 
 class ReplayRegression : public ::testing::Test {
  protected:
-  void SetUp() override {
+  // collision: run mannequin-collision with the sim (lockstep by step number)
+  void prepare(bool collision) {
+    collision_ = collision;
+    if (collision && !fs::exists(binDir() / "mannequin-collision")) GTEST_SKIP() << "mannequin-collision is not built";
     for (const char* tool : {"mannequin-mocap", "mannequin-sim", "mannequin-record", "mannequin-replay"}) {
       if (!fs::exists(binDir() / tool)) GTEST_SKIP() << tool << " is not built";
     }
     dir_ = tempPath("regression");
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    // the shipped demo sim config, in replay (deterministic) mode, without collision. sim.world at
+    // the shipped demo sim config, in replay (deterministic) mode. sim.world at
     // 60 Hz of simulation time only: publish_on_mocap would make the number of worlds depend on how
     // the frames are batched on arrival (143 worlds for 315 frames replayed --fast, 366 in lockstep)
     spit(dir_ / "sim.yaml", R"(name: sim
@@ -83,15 +92,26 @@ interpolation_delay: 0.0084
 occlusion: {hold: 0.3, blend: 0.5}
 calibration: {needs_flag: false}
 gains: {task: 40, posture: 2, damping: 0.05, max_speed: 20}
-collision: {mode: none}
+collision: )" + std::string(collision_ ? "{mode: service, period_steps: 10, replay_deadline: 5.0, margin: 0.02}"
+                                                  : "{mode: none}") + R"(
 mannequins:
   - name: operator
     config: configs/mannequins/male_50th.yaml
     root_frame: pelvis
     control_frames: {pelvis: pelvis, thorax: thorax, head: head, hand_l: hand_l, hand_r: hand_r, foot_l: foot_l, foot_r: foot_r}
 )");
+    // the shipped collision config (floor + the demo mannequin)
+    spit(dir_ / "collision.yaml", R"(name: collision
+publish: ipc:///unused
+connect: []
+scene: configs/scenes/floor.yaml
+activation_distance: 0.02
+mannequins:
+  - {name: operator, config: configs/mannequins/male_50th.yaml, margin: 0.0, self_collision: true}
+)");
   }
   void TearDown() override {
+    if (dir_.empty()) return;
     if (!::testing::Test::HasFailure()) fs::remove_all(dir_);
   }
   std::string ep(const std::string& name) const { return "ipc://" + (dir_ / (name + ".ipc")).string(); }
@@ -101,9 +121,17 @@ mannequins:
   // a fresh sim fed by a replay of `input`; its sim.world recorded into `out`
   void simRun(const std::string& tag, const fs::path& input, const fs::path& out, const std::vector<std::string>& replay_extra) {
     const std::string sim_ep = ep("sim-" + tag), replay_ep = ep("replay-" + tag);
-    const pid_t sim = spawn({bin("mannequin-sim"), "--config", (dir_ / "sim.yaml").string(), "--publish", sim_ep,
-                             "--connect", replay_ep, "--log-level", "warn"},
-                            dir_ / ("sim-" + tag + ".log"));
+    const std::string collision_ep = ep("collision-" + tag);
+    pid_t collision = -1;
+    if (collision_) {
+      collision = spawn({bin("mannequin-collision"), "--config", (dir_ / "collision.yaml").string(), "--publish",
+                         collision_ep, "--connect", sim_ep, "--log-level", "warn"},
+                        dir_ / ("collision-" + tag + ".log"));
+    }
+    std::vector<std::string> sim_args = {bin("mannequin-sim"), "--config", (dir_ / "sim.yaml").string(), "--publish",
+                                         sim_ep, "--connect", replay_ep, "--log-level", "warn"};
+    if (collision_) sim_args.insert(sim_args.end(), {"--connect", collision_ep});
+    const pid_t sim = spawn(sim_args, dir_ / ("sim-" + tag + ".log"));
     // the recorder connects once the sim has bound (its ipc socket exists), then has a second to
     // subscribe: a fast replay is over in milliseconds, and what the sim publishes before the
     // recorder's subscription reaches it is lost (PUB/SUB)
@@ -130,15 +158,34 @@ mannequins:
     }
     EXPECT_EQ(stopAndWait(rec), 0) << log("record-" + tag);
     EXPECT_EQ(stopAndWait(sim), 0) << log("sim-" + tag);
+    if (collision_) {
+      EXPECT_EQ(stopAndWait(collision), 0) << log("collision-" + tag);
+    }
   }
 
   fs::path dir_;
+  bool collision_ = false;
+
+
+  void run();
 };
 
 TEST_F(ReplayRegression, EverySimWorldIsByteIdenticalToTheRecordedOne) {
-  // 1. record a mocap stream (synthetic actor, with an occlusion of hand_l from 1.0 to 1.5 s)
+  prepare(false);
+  if (IsSkipped()) return;
+  run();
+}
+
+TEST_F(ReplayRegression, DISABLED_WithCollisionEverySimWorldIsByteIdentical) {
+  prepare(true);
+  if (IsSkipped()) return;
+  run();
+}
+
+void ReplayRegression::run() {
+  // 1. record a mocap stream (the shipped CMU capture played as a tracker streams it, 120 Hz)
   const fs::path mocap = dir_ / "mocap.mcap";
-  const std::string mocap_cfg = sourceDir() + "/configs/sim/mocap_synthetic.yaml";
+  const std::string mocap_cfg = sourceDir() + "/configs/sim/mocap_demo.yaml";
   const pid_t rec = spawn({bin("mannequin-record"), "--connect", ep("mocap"), "--topics", "mocap.frame", "--out",
                            mocap.string(), "--duration", "3.0", "--progress", "0"},
                           dir_ / "record-mocap.log");
@@ -195,7 +242,37 @@ TEST_F(ReplayRegression, EverySimWorldIsByteIdenticalToTheRecordedOne) {
       first = std::min(first, i);
     }
   }
-  EXPECT_EQ(differing, 0U) << "first differing sim.world: #" << first << " of " << want.size();
+  std::string detail;
+  if (differing > 0) {
+    mannequin::v1::WorldState a, b;
+    a.ParseFromString(want[first].data);
+    b.ParseFromString(got[first].data);
+    google::protobuf::util::MessageDifferencer diff;
+    diff.ReportDifferencesToString(&detail);
+    diff.Compare(a, b);
+    detail = "\nstep " + std::to_string(a.step()) + ": contacts_step " + std::to_string(a.contacts_step()) + " -> " +
+             std::to_string(b.contacts_step()) + ", contacts_stale " + std::to_string(a.contacts_stale()) + " -> " +
+             std::to_string(b.contacts_stale()) + "\n" + detail.substr(0, 1500);
+  }
+  EXPECT_EQ(differing, 0U) << "first differing sim.world: #" << first << " of " << want.size() << detail;
+
+  // the worlds are real: calibrated mannequin, contacts with the floor in time (never stale)
+  std::size_t calibrated = 0, with_contacts = 0, stale = 0;
+  for (const Message& m : want) {
+    mannequin::v1::WorldState w;
+    ASSERT_TRUE(w.ParseFromString(m.data));
+    EXPECT_EQ(w.mode(), "replay");
+    EXPECT_EQ(w.header().send_time_ns(), 0);
+    ASSERT_EQ(w.mannequins_size(), 1);
+    calibrated += w.mannequins(0).calibrated();
+    with_contacts += w.mannequins(0).contacts_size() > 0;
+    stale += w.contacts_stale();
+  }
+  EXPECT_GT(calibrated, want.size() / 2);
+  if (collision_) {
+    EXPECT_GT(with_contacts, want.size() / 2) << "feet on the floor";
+    EXPECT_EQ(stale, 0U);
+  }
 }
 
 }  // namespace
