@@ -173,7 +173,7 @@ int main(int argc, char** argv) {
     if (pub.subscriptions() == 0) spdlog::warn("no subscriber yet; replaying anyway");
 
     const bool keys = !no_keys && ::isatty(STDIN_FILENO) == 1;
-    tools::TerminalControl control(stop, keys, [&] { pub.poll(); });
+    tools::TerminalControl control(stop, keys, [&] { pub.poll(); }, paused);
     if (keys) spdlog::info("keys: space = pause/resume, n = step, q = quit");
 
     auto last_progress = std::chrono::steady_clock::now();

@@ -7,10 +7,13 @@
 #include <chrono>
 #include <thread>
 
+#include <spdlog/spdlog.h>
+
 namespace mannequin::tools {
 
-TerminalControl::TerminalControl(const std::atomic<bool>& stop, bool interactive, std::function<void()> idle)
-    : stop_(stop), idle_(std::move(idle)) {
+TerminalControl::TerminalControl(const std::atomic<bool>& stop, bool interactive, std::function<void()> idle,
+                                 bool start_paused)
+    : stop_(stop), idle_(std::move(idle)), paused_(start_paused) {
   if (interactive && ::isatty(STDIN_FILENO) == 1 && ::tcgetattr(STDIN_FILENO, &saved_) == 0) {
     termios raw = saved_;
     raw.c_lflag &= ~static_cast<tcflag_t>(ICANON | ECHO);
@@ -44,9 +47,15 @@ recording::PlayerCommand TerminalControl::waitUntil(recording::WallTime deadline
         char c = 0;
         if (::read(STDIN_FILENO, &c, 1) == 1) {
           switch (c) {
-            case ' ': return recording::PlayerCommand::kTogglePause;
+            case ' ':
+              paused_ = !paused_;
+              spdlog::info(paused_ ? "paused (space = resume, n = step)" : "resumed");
+              return recording::PlayerCommand::kTogglePause;
             case 'n':
-            case 's': return recording::PlayerCommand::kStep;
+            case 's':
+              if (!paused_) spdlog::info("paused; stepping (space = resume)");
+              paused_ = true;
+              return recording::PlayerCommand::kStep;
             case 'q': return recording::PlayerCommand::kQuit;
             default: break;
           }

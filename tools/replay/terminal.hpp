@@ -13,8 +13,9 @@ namespace mannequin::tools {
 
 class TerminalControl : public recording::ReplayControl {
  public:
-  /// interactive: read keys from stdin (ignored when stdin is not a TTY).
-  TerminalControl(const std::atomic<bool>& stop, bool interactive, std::function<void()> idle);
+  /// interactive: read keys from stdin (ignored when stdin is not a TTY); start_paused: the
+  /// player starts paused (for the messages shown on key presses).
+  TerminalControl(const std::atomic<bool>& stop, bool interactive, std::function<void()> idle, bool start_paused = false);
   ~TerminalControl() override;
   TerminalControl(const TerminalControl&) = delete;
   TerminalControl& operator=(const TerminalControl&) = delete;
@@ -27,6 +28,7 @@ class TerminalControl : public recording::ReplayControl {
   const std::atomic<bool>& stop_;
   std::function<void()> idle_;
   bool tty_ = false;
+  bool paused_ = false;
   termios saved_{};
 };
 
