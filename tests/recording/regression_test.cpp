@@ -132,29 +132,42 @@ mannequins:
                                          sim_ep, "--connect", replay_ep, "--log-level", "warn"};
     if (collision_) sim_args.insert(sim_args.end(), {"--connect", collision_ep});
     const pid_t sim = spawn(sim_args, dir_ / ("sim-" + tag + ".log"));
-    // the recorder connects once the sim has bound (its ipc socket exists), then has a second to
-    // subscribe: a fast replay is over in milliseconds, and what the sim publishes before the
-    // recorder's subscription reaches it is lost (PUB/SUB)
+    // the replay must not start before the recorder is subscribed to the sim: a fast replay is over
+    // in milliseconds, and what the sim publishes before the recorder's subscription reaches it is
+    // lost (PUB/SUB). The recorder also records the sim's heartbeats (every 0.5 s): once the
+    // heartbeat channel is in its file (Channel records are written at once), it is subscribed.
     const fs::path sim_socket = dir_ / ("sim-" + tag + ".ipc");
     for (int i = 0; i < 200 && !fs::exists(sim_socket); ++i) std::this_thread::sleep_for(std::chrono::milliseconds(50));
     ASSERT_TRUE(fs::exists(sim_socket)) << log("sim-" + tag);
-    const pid_t rec = spawn({bin("mannequin-record"), "--connect", sim_ep, "--topics", "sim.world", "--out", out.string(),
-                             "--duration", "60", "--progress", "0", "--flush-interval", "0.1"},
+    const pid_t rec = spawn({bin("mannequin-record"), "--connect", sim_ep, "--topics", "sim.world,health.heartbeat",
+                             "--out", out.string(), "--duration", "60", "--progress", "0", "--flush-interval", "0.1"},
                             dir_ / ("record-" + tag + ".log"));
-    std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+    for (int i = 0; i < 300 && slurp(out).find("health.heartbeat") == std::string::npos; ++i) {
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+    ASSERT_NE(slurp(out).find("health.heartbeat"), std::string::npos) << log("record-" + tag) << log("sim-" + tag);
     std::vector<std::string> args = {bin("mannequin-replay"), input.string(), "--publish", replay_ep, "--topics",
                                      "mocap.frame", "--wait-subscribers", "10", "--progress", "0"};
     args.insert(args.end(), replay_extra.begin(), replay_extra.end());
     const int replay = waitExit(spawn(args, dir_ / ("replay-" + tag + ".log")));
     EXPECT_EQ(replay, 0) << log("replay-" + tag);
-    // let the sim finish its queue and the recorder write the last worlds (file unchanged for 1 s;
-    // the recorder writes its open chunk every 0.1 s)
-    std::uintmax_t size = 0;
-    for (int i = 0, stable = 0; i < 60 && stable < 4; ++i) {
+    // let the sim finish its queue and the recorder write the last worlds: the number of sim.world
+    // in the file being written (read back by the recovery scan: no footer yet) unchanged for 1 s
+    auto worlds = [&out]() -> std::size_t {
+      try {
+        ReadFilter f;
+        f.topics = {"sim.world"};
+        return McapReader::open(out.string()).readAll(f).size();
+      } catch (const McapError&) {
+        return 0;  // no sim.world yet
+      }
+    };
+    std::size_t count = 0;
+    for (int i = 0, stable = 0; i < 120 && stable < 4; ++i) {
       std::this_thread::sleep_for(std::chrono::milliseconds(250));
-      const std::uintmax_t s = fs::exists(out) ? fs::file_size(out) : 0;
-      stable = s == size ? stable + 1 : 0;
-      size = s;
+      const std::size_t n = worlds();
+      stable = n == count && n > 0 ? stable + 1 : 0;
+      count = n;
     }
     EXPECT_EQ(stopAndWait(rec), 0) << log("record-" + tag);
     EXPECT_EQ(stopAndWait(sim), 0) << log("sim-" + tag);
@@ -230,7 +243,7 @@ void ReplayRegression::run() {
   ReadFilter worlds;
   worlds.topics = {"sim.world"};
   const std::vector<Message> want = g.readAll(worlds);
-  const std::vector<Message> got = McapReader::open(world2.string()).readAll();
+  const std::vector<Message> got = McapReader::open(world2.string()).readAll(worlds);
   // 60 Hz of simulation time over the capture
   const double capture_s = (input.statistics().message_end_time - input.statistics().message_start_time) * 1e-9;
   ASSERT_GT(static_cast<double>(want.size()), 0.9 * 60.0 * capture_s) << log("sim-golden");
