@@ -3,10 +3,11 @@
 #include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
+#include <poll.h>
+
 #include <algorithm>
 #include <cerrno>
 #include <stdexcept>
-#include <thread>
 
 #include "mannequin/transport/clock.hpp"
 
@@ -131,19 +132,17 @@ int Subscriber::poll(std::chrono::microseconds timeout) {
 
 int Subscriber::pollImpl(std::chrono::microseconds timeout) {
   delivered_in_poll_ = 0;
-  zmq::pollitem_t item{socket_.handle(), 0, ZMQ_POLLIN, 0};
-  const long timeout_ms = static_cast<long>((timeout.count() + 999) / 1000);
   if (timeout.count() > 0) {
-    // zmq_poll has millisecond resolution; short waits check every ~50 us instead
-    if (timeout.count() < 2000) {
-      const std::int64_t until = steadyNs() + timeout.count() * 1000;
-      while (zmq::poll(&item, 1, std::chrono::milliseconds(0)) == 0) {
-        const std::int64_t left = until - steadyNs();
-        if (left <= 0) break;
-        std::this_thread::sleep_for(std::chrono::nanoseconds(std::min<std::int64_t>(left, 50000)));
-      }
-    } else {
-      zmq::poll(&item, 1, std::chrono::milliseconds(timeout_ms));
+    // wait on the socket's file descriptor with a nanosecond timeout (zmq_poll has millisecond
+    // resolution): ZMQ_FD only signals that ZMQ_EVENTS may have changed, so re-check it after each wake
+    const int fd = socket_.get(zmq::sockopt::fd);
+    const std::int64_t until = steadyNs() + timeout.count() * 1000;
+    while ((socket_.get(zmq::sockopt::events) & ZMQ_POLLIN) == 0) {
+      const std::int64_t left = until - steadyNs();
+      if (left <= 0) break;
+      pollfd p{fd, POLLIN, 0};
+      const timespec ts{static_cast<time_t>(left / 1000000000), static_cast<long>(left % 1000000000)};
+      ppoll(&p, 1, &ts, nullptr);
     }
   }
   zmq::message_t topic_msg, payload;
