@@ -161,8 +161,8 @@ void Controller::build(const VectorX& q0) {
   q_next_.setZero(model_.nq);
   J_.setZero(rows_, nv_);
   JB_.setZero(rows_, nv_);
-  b_.setZero(nv_, nv_);
-  llt_ = Eigen::LLT<MatrixX>(nv_);
+  b_.setIdentity(nv_, nv_);
+  llt_.compute(b_);  // allocates the factor once (and sets its status, which Eigen leaves unset)
   wrench_ff_.assign(nf, Vector6::Zero());
   damping_total_.assign(nf, Vector6::Zero());
   vd_c_.assign(nf, Vector6::Zero());
@@ -489,8 +489,11 @@ std::vector<StabilityEntry> Controller::checkStability() {
   free_motion_ready_ = false;
   std::vector<StabilityEntry> out;
   // per axis: k δt e_aᵀ J b⁻¹ Jᵀ e_a, i.e. k δt / b_eff along that axis (2.11)
-  const MatrixX X = llt_.solve(MatrixX(J_.transpose()));  // b⁻¹ Jᵀ
-  const MatrixX C = J_ * X;                               // J b⁻¹ Jᵀ
+  MatrixX C = MatrixX::Zero(rows_, rows_);  // J b⁻¹ Jᵀ
+  if (rows_ > 0) {
+    const MatrixX X = llt_.solve(MatrixX(J_.transpose()));  // b⁻¹ Jᵀ
+    C = J_ * X;
+  }
   VectorX Ksqrt = VectorX::Zero(rows_);
   for (int i = 0; i < numFrames(); ++i) {
     const ControlFrameState& f = frames_[i];

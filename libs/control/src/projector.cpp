@@ -20,13 +20,10 @@ WeightedNullSpace::WeightedNullSpace(int rows, int n, ProjectorMethod method, do
   z_.setZero(rows);
   t_.setZero(n);
   r_.setZero(rows);
-  if (rows > 0) {
-    if (method == ProjectorMethod::kLdlt) {
-      ldlt_ = Eigen::LDLT<MatrixX>(rows);
-    } else {
-      svd_ = Eigen::JacobiSVD<MatrixX>(rows, n, Eigen::ComputeThinV);
-    }
-  }
+  // factorise once here so that the workspaces are allocated and the decompositions' status is set
+  // (Eigen leaves it uninitialised until the first compute, and this object gets copied)
+  ldlt_.compute(MatrixX::Identity(rows, rows));
+  if (rows > 0 && method == ProjectorMethod::kSvd) svd_ = Eigen::JacobiSVD<MatrixX>(rows, n, Eigen::ComputeThinV);
 }
 
 void WeightedNullSpace::compute(const Eigen::Ref<const MatrixX>& J, const VectorX& w_inv) {
