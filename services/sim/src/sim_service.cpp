@@ -80,30 +80,38 @@ struct SimService::Impl {
     awaiting = false;
   }
 
-  // Before a step: collision lockstep (wait for the previous query's answer, send the next query).
+  // Waits for the contacts of the query in flight, up to the deadline; past it the previous set stays
+  // in use and is flagged stale.
+  void waitForContacts(const std::atomic<bool>& stop) {
+    const double deadline = config.mode == Mode::kReplay ? config.collision.replay_deadline : config.collision.deadline;
+    const std::int64_t until = query_sent_ns + static_cast<std::int64_t>(deadline * 1e9);
+    while (awaiting && !stop.load()) {
+      const std::int64_t left = until - transport::steadyNs();
+      if (left <= 0) break;
+      sub.poll(microseconds(std::min<std::int64_t>(left / 1000, 20000)));
+    }
+    if (awaiting) {
+      stale = true;
+      ++stats.stale_contacts;
+      awaiting = false;
+    }
+  }
+
+  // Before a step: collision lockstep. Live: pipelined, the answer to query n is awaited before query
+  // n + period (the steps in between use whichever set arrived). Replay: synchronous, the answer is
+  // awaited right after the query, so every step uses the contacts of the last query step — the same
+  // set whatever the timing (deterministic output).
   void collisionBeforeStep(const std::atomic<bool>& stop) {
     if (config.collision.mode != CollisionMode::kService) return;
     if (world.stepCount() % static_cast<std::uint64_t>(config.collision.period_steps) != 0) return;
-    if (awaiting) {
-      const double deadline = config.mode == Mode::kReplay ? config.collision.replay_deadline : config.collision.deadline;
-      const std::int64_t until = query_sent_ns + static_cast<std::int64_t>(deadline * 1e9);
-      while (awaiting && !stop.load()) {
-        const std::int64_t left = until - transport::steadyNs();
-        if (left <= 0) break;
-        sub.poll(microseconds(std::min<std::int64_t>(left / 1000, 20000)));
-      }
-      if (awaiting) {
-        stale = true;
-        ++stats.stale_contacts;
-        awaiting = false;
-      }
-    }
+    if (awaiting) waitForContacts(stop);
     toCollisionQuery(world, config.collision.margin, query_msg);
     pub.publish(topics::kCollisionQuery, query_msg);
     ++stats.queries;
     awaiting = true;
     awaited_step = world.stepCount();
     query_sent_ns = transport::steadyNs();
+    if (config.mode == Mode::kReplay) waitForContacts(stop);
   }
 
   void stepOnce(const std::atomic<bool>& stop) {

@@ -8,8 +8,9 @@
 /// Replay mode: driven by input timestamps, no wall clock: each mocap frame (in arrival order) makes the
 /// World step until its capture time; same inputs ⇒ same sim.world bytes (send_time_ns = 0).
 /// Collision (mode service): every period_steps steps it publishes collision.query (step number, every
-/// mannequin's q) and, before the next query, waits for collision.contacts of that step up to the
-/// deadline; past it the previous set is reused and sim.world says contacts_stale.
+/// mannequin's q) and waits for collision.contacts of that step up to the deadline — live: before the
+/// next query (pipelined); replay: at once (synchronous, so the contacts used do not depend on timing);
+/// past the deadline the previous set is reused and sim.world says contacts_stale.
 #include <atomic>
 #include <memory>
 
