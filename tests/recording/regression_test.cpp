@@ -4,11 +4,9 @@
 // byte-identical to the recorded one of the first (same build: no floating-point tolerance is
 // needed, none is used).
 //
-// With collision in the loop the test is DISABLED: mannequin-sim (replay mode) uses in each
-// sim.world whichever collision.contacts set has arrived by then, so the contacts of a world depend
-// on timing (seen: the world of step 17 carried the contacts of step 0 in one run and of step 10 in
-// the other; ~10 of 156 worlds differ). Enable it when the sim waits for the contacts of its query
-// deterministically in replay mode. Not covered: scenario triggers (no scenario service yet).
+// With collision in the loop: in replay mode mannequin-sim waits for the contacts of each query
+// (commit 471f4cc); before that the contacts of a world depended on timing (~10 of 156 worlds
+// differed). Not covered: scenario triggers (no scenario service yet).
 #include <gtest/gtest.h>
 #include <signal.h>
 #include <sys/wait.h>
@@ -189,7 +187,7 @@ TEST_F(ReplayRegression, EverySimWorldIsByteIdenticalToTheRecordedOne) {
   run();
 }
 
-TEST_F(ReplayRegression, DISABLED_WithCollisionEverySimWorldIsByteIdentical) {
+TEST_F(ReplayRegression, WithCollisionEverySimWorldIsByteIdentical) {
   prepare(true);
   if (IsSkipped()) return;
   run();
