@@ -131,9 +131,10 @@ services:
       }
   }
   EXPECT_GT(travel, 0.2) << "the pelvis should follow the capture";
-  // the hand follows its body: the kinematic stand-in of the control library, calibrated on the first
-  // frame of this capture, keeps a mean error of ~0.1 m on the CMU hop (docs/cluster.md)
-  EXPECT_LT(mean_hand, 0.2) << "worst " << worst_hand;
+  // the hand follows its body: the controller (configs/control/mocap.yaml), calibrated on the first
+  // frame of this capture, keeps a mean error of ~0.012 m (worst ~0.05 m) on the CMU hop; the kinematic
+  // tracker gave ~0.1 m (docs/cluster.md). Bound with margin for a loaded machine (live mode).
+  EXPECT_LT(mean_hand, 0.05) << "worst " << worst_hand;
   std::printf("hand_l position error over %zu states: mean %.3f m, worst %.3f m\n", worlds.size(), mean_hand, worst_hand);
   bool contacts_seen = false;
   for (const auto& w : worlds) contacts_seen = contacts_seen || w.mannequins(0).contacts_size() > 0;

@@ -89,14 +89,15 @@ publish_on_mocap: false
 interpolation_delay: 0.0084
 occlusion: {hold: 0.3, blend: 0.5}
 calibration: {needs_flag: false}
-gains: {task: 40, posture: 2, damping: 0.05, max_speed: 20}
+stepper: controller
 collision: )" + std::string(collision_ ? "{mode: service, period_steps: 10, replay_deadline: 5.0, margin: 0.02}"
                                                   : "{mode: none}") + R"(
 mannequins:
   - name: operator
     config: configs/mannequins/male_50th.yaml
     root_frame: pelvis
-    control_frames: {pelvis: pelvis, thorax: thorax, head: head, hand_l: hand_l, hand_r: hand_r, foot_l: foot_l, foot_r: foot_r}
+    controller: configs/control/mocap.yaml
+    control_frames: {pelvis: pelvis, head: head, hand_l: hand_l, hand_r: hand_r, foot_l: foot_l, foot_r: foot_r}
 )");
     // the shipped collision config (floor + the demo mannequin)
     spit(dir_ / "collision.yaml", R"(name: collision

@@ -1,6 +1,8 @@
 #include "mannequin/sim/tracker.hpp"
 
+#include <cmath>
 #include <stdexcept>
+#include <string>
 
 #include "mannequin/math/pinv.hpp"
 
@@ -20,7 +22,17 @@ KinematicTracker::KinematicTracker(const skeleton::Model& model, std::vector<int
   reset(q0);
 }
 
+void KinematicTracker::setPosture(const skeleton::VectorX& q_posture) {
+  if (q_posture.size() != model_.nq || !q_posture.allFinite())
+    throw std::invalid_argument("tracker: posture of size " + std::to_string(q_posture.size()) + " (expected " +
+                                std::to_string(model_.nq) + ") or with non-finite values");
+  q_posture_ = q_posture;
+}
+
 void KinematicTracker::reset(const skeleton::VectorX& q) {
+  if (q.size() != model_.nq || !q.allFinite())
+    throw std::invalid_argument("tracker: configuration of size " + std::to_string(q.size()) + " (expected " +
+                                std::to_string(model_.nq) + ") or with non-finite values");
   q_ = q;
   qdot_ = skeleton::VectorX::Zero(model_.nv);
   skeleton::forwardKinematics(model_, data_, q_);
@@ -30,6 +42,7 @@ void KinematicTracker::reset(const skeleton::VectorX& q) {
 }
 
 void KinematicTracker::setTarget(int i, const math::SE3& oMd, double weight) {
+  if (!oMd.R.allFinite() || !oMd.p.allFinite() || !std::isfinite(weight)) return;  // keep the previous target
   targets_.at(i) = oMd;
   weights_.at(i) = weight;
 }

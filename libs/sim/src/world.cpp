@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "mannequin/math/so3.hpp"
+#include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
 namespace mannequin::sim {
@@ -15,8 +16,11 @@ struct World::Mannequin {
   skeleton::Model model;
   std::vector<ControlFrameSpec> specs;
   int root_frame = -1;
-  std::unique_ptr<KinematicTracker> tracker;
+  std::vector<int> frame_indices;
+  std::unique_ptr<Stepper> tracker;
   std::vector<ControlFrameStatus> frames;
+  std::vector<math::SE3> previous_targets;  // targets of the previous step (target twist)
+  std::vector<bool> have_previous;
   std::vector<double> weights;  // current weights (rate-limited)
   bool calibrated = false;
   skeleton::VectorX q_standing;
@@ -47,7 +51,19 @@ World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : conf
     }
     m->weights.assign(m->frames.size(), 0.0);
     m->q_standing = skeleton::standingConfiguration(m->model);
-    m->tracker = std::make_unique<KinematicTracker>(m->model, idx, config_.gains, m->q_standing);
+    m->frame_indices = idx;
+    if (s.controller) {
+      try {
+        m->tracker = std::make_unique<ControllerStepper>(m->model, *s.controller, idx, config_.step, m->q_standing,
+                                                         config_.joint_limits);
+      } catch (const std::invalid_argument& e) {
+        throw std::invalid_argument("sim: mannequin '" + s.name + "': " + e.what());
+      }
+    } else {
+      m->tracker = std::make_unique<KinematicTracker>(m->model, idx, config_.gains, m->q_standing);
+    }
+    m->previous_targets.resize(idx.size());
+    m->have_previous.assign(idx.size(), false);
     for (auto& st : m->frames) st.target = st.actual = m->tracker->data().oMf[st.frame_index];
     mannequins_.push_back(std::move(m));
   }
@@ -61,6 +77,7 @@ const skeleton::Data& World::data(int m) const { return mannequins_.at(m)->track
 const skeleton::VectorX& World::q(int m) const { return mannequins_.at(m)->tracker->q(); }
 const skeleton::VectorX& World::qdot(int m) const { return mannequins_.at(m)->tracker->qdot(); }
 bool World::calibrated(int m) const { return mannequins_.at(m)->calibrated; }
+const Stepper& World::stepper(int m) const { return *mannequins_.at(m)->tracker; }
 const std::vector<ControlFrameStatus>& World::controlFrames(int m) const { return mannequins_.at(m)->frames; }
 
 void World::anchor(std::int64_t capture_ns) {
@@ -102,21 +119,23 @@ void World::calibrate(Mannequin& m, const MocapInput& frame) {
           qc.segment<3>(3) = math::logSO3(R);
         }
       }
-  m.tracker->reset(qc);
   if (config_.calibration_fit_steps > 0) {
     // fit the posture to the bodies' positions first (orientations free), so that the offsets only
     // hold what differs between the tracker's and the model's frames, not a posture mismatch
+    KinematicTracker fit(m.model, m.frame_indices, config_.gains, qc);
     for (int k = 0; k < config_.calibration_fit_steps; ++k) {
       for (std::size_t i = 0; i < m.frames.size(); ++i) {
-        math::SE3 T = m.tracker->data().oMf[m.frames[i].frame_index];
+        math::SE3 T = fit.data().oMf[m.frames[i].frame_index];
         T.p = find(m.frames[i].body)->pose.p;
-        m.tracker->setTarget(static_cast<int>(i), T, 1.0);
+        fit.setTarget(static_cast<int>(i), T, 1.0);
       }
-      if (!m.tracker->step(config_.step)) break;
+      if (!fit.step(config_.step)) break;
     }
-    m.tracker->reset(m.tracker->q());
+    qc = fit.q();
   }
-  m.tracker->setPosture(m.tracker->q());
+  m.tracker->reset(qc);
+  m.tracker->setPosture(qc);
+  std::fill(m.have_previous.begin(), m.have_previous.end(), false);
   const skeleton::Data& d = m.tracker->data();
   for (auto& st : m.frames) {
     const BodyInput* b = find(st.body);
@@ -131,6 +150,23 @@ void World::addMocap(const MocapInput& frame) {
   if (!buffer_.add(frame)) return;
   for (auto& m : mannequins_)
     if (!m->calibrated) calibrate(*m, frame);
+}
+
+math::Vector6 World::targetTwist(Mannequin& m, std::size_t i, double dt) const {
+  const math::SE3& T = m.frames[i].target;
+  math::Vector6 V = math::Vector6::Zero();
+  if (config_.target_twist && m.have_previous[i]) {
+    const math::SE3& P = m.previous_targets[i];
+    V.head<3>() = math::logSO3(P.R.transpose() * T.R) / dt;
+    V.tail<3>() = T.R.transpose() * (T.p - P.p) / dt;
+    // a jump (re-tracked body, re-anchored clock) is not a motion to feed forward
+    if (!V.allFinite() || V.tail<3>().norm() > config_.max_target_speed ||
+        0.3 * V.head<3>().norm() > config_.max_target_speed)
+      V.setZero();
+  }
+  m.previous_targets[i] = T;
+  m.have_previous[i] = true;
+  return V;
 }
 
 bool World::step() {
@@ -158,10 +194,11 @@ bool World::step() {
         const double rate = dt / std::max(config_.occlusion_blend, 1e-9);
         double& w = m.weights[i];
         w = goal > w ? std::min(goal, w + rate) : goal;
-        m.tracker->setTarget(static_cast<int>(i), st.target, w);
+        m.tracker->setTarget(static_cast<int>(i), st.target, targetTwist(m, i, dt), w);
       }
     } else {
-      for (std::size_t i = 0; i < m.frames.size(); ++i) m.tracker->setTarget(static_cast<int>(i), m.frames[i].target, 0.0);
+      for (std::size_t i = 0; i < m.frames.size(); ++i)
+        m.tracker->setTarget(static_cast<int>(i), m.frames[i].target, math::Vector6::Zero(), 0.0);
     }
     if (!m.tracker->step(dt)) {
       ok = false;

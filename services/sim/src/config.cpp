@@ -8,7 +8,8 @@ using service::ConfigNode;
 
 SimServiceConfig parseSimConfig(const ConfigNode& root) {
   root.allowOnly({"name", "publish", "connect", "mode", "step", "world_rate", "publish_on_mocap", "interpolation_delay",
-                  "reanchor_threshold", "occlusion", "calibration", "gains", "collision", "mannequins"});
+                  "reanchor_threshold", "occlusion", "calibration", "gains", "collision", "mannequins", "stepper",
+                  "target_twist", "joint_limits"});
   SimServiceConfig c;
   c.name = root.get("name", c.name);
   if (auto p = root.find("publish")) c.publish = p->strings();
@@ -39,6 +40,31 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
     c.world.calibration_fit_steps = o->get("fit_steps", c.world.calibration_fit_steps);
     if (c.world.calibration_fit_steps < 0) (*o)["fit_steps"].fail("must be >= 0");
   }
+  if (auto st = root.find("stepper")) {
+    const std::string v = st->str();
+    if (v == "controller")
+      c.stepper = StepperKind::kController;
+    else if (v == "kinematic")
+      c.stepper = StepperKind::kKinematic;
+    else
+      st->fail("expected controller or kinematic");
+  }
+  if (auto tt = root.find("target_twist")) {
+    tt->allowOnly({"enabled", "max_speed"});
+    c.world.target_twist = tt->get("enabled", c.world.target_twist);
+    c.world.max_target_speed = tt->getIn("max_speed", c.world.max_target_speed, 0.0, 1e3);
+  }
+  if (auto jl = root.find("joint_limits")) {
+    jl->allowOnly({"enabled", "activation", "recovery_speed"});
+    if (!jl->get("enabled", true)) {
+      c.world.joint_limits.reset();
+    } else {
+      constraints::JointLimitOptions o;
+      o.activation = jl->getIn("activation", o.activation, 0.0, 1.0);
+      o.recovery_speed = jl->getIn("recovery_speed", o.recovery_speed, 0.0, 100.0);
+      c.world.joint_limits = o;
+    }
+  }
   if (auto g = root.find("gains")) {
     g->allowOnly({"task", "posture", "damping", "max_speed"});
     c.world.gains.task = g->getIn("task", c.world.gains.task, 0.0, 1e4);
@@ -63,11 +89,12 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
     c.collision.margin = col->getIn("margin", c.collision.margin, 0.0, 1.0);
   }
   for (const ConfigNode& m : root["mannequins"].items()) {
-    m.allowOnly({"name", "config", "root_frame", "control_frames"});
+    m.allowOnly({"name", "config", "root_frame", "control_frames", "controller"});
     MannequinEntry e;
     e.name = m["name"].str();
     e.config = m["config"].str();
     e.root_frame = m.get("root_frame", e.root_frame);
+    e.controller = m.get("controller", e.controller);
     const ConfigNode frames = m["control_frames"];
     for (const std::string& f : frames.keys()) e.frames.push_back({f, frames[f].str()});
     if (e.frames.empty()) frames.fail("no control frame");
@@ -93,6 +120,13 @@ std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config)
         for (const auto& fr : s.model.frames) list += (list.empty() ? "" : ", ") + fr.name;
         throw service::ConfigError("mannequin '" + e.name + "': no frame '" + f.frame + "' in " + e.config + " (frames: " + list + ")");
       }
+    if (config.stepper == StepperKind::kController) {
+      try {
+        s.controller = control::loadControllerConfig(e.controller);
+      } catch (const std::exception& ex) {
+        throw service::ConfigError("mannequin '" + e.name + "': controller: " + ex.what());
+      }
+    }
     out.push_back(std::move(s));
   }
   return out;

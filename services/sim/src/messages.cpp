@@ -69,6 +69,7 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
       c->set_weight(st.weight);
     }
     ms->set_balance_distance(NAN);
+    ms->set_port_energy(world.stepper(i).portEnergy());
     if (contacts != nullptr)
       for (const v1::Contact& k : contacts->contacts()) {
         if (k.mannequin_a() != world.name(i) && k.mannequin_b() != world.name(i)) continue;

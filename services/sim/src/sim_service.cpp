@@ -159,9 +159,10 @@ std::vector<std::string> SimService::boundEndpoints() const { return impl_->pub.
 
 int SimService::run(const std::atomic<bool>& stop, double duration) {
   Impl& s = *impl_;
-  spdlog::info("{}: {} mode, step {} ms, sim.world at {:.1f} Hz, {} mannequin(s), publishing on {}, connected to {}", s.config.name,
-               s.config.mode == Mode::kLive ? "live" : "replay", s.config.world.step * 1e3,
-               s.config.world_rate, s.world.numMannequins(), fmt::join(s.pub.boundEndpoints(), ", "),
+  spdlog::info("{}: {} mode, step {} ms, sim.world at {:.1f} Hz, {} mannequin(s) stepped by the {}, publishing on {}, connected to {}",
+               s.config.name, s.config.mode == Mode::kLive ? "live" : "replay", s.config.world.step * 1e3,
+               s.config.world_rate, s.world.numMannequins(),
+               s.config.stepper == StepperKind::kController ? "controller" : "kinematic tracker", fmt::join(s.pub.boundEndpoints(), ", "),
                fmt::join(s.config.connect, ", "));
   s.health.setState(v1::SERVICE_STATE_RUNNING);
   s.health.tick(true);

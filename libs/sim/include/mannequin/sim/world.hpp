@@ -12,7 +12,13 @@
 /// root frame, then fitted for `calibration_fit_steps` tracker steps so that every control frame's origin
 /// reaches its body's position) and each control frame f driven by body b keeps the offset
 /// bMf = oMb(c)⁻¹ · oMf(q_c); q_c is also the posture target;
-/// afterwards its target is oMd(t) = oMb(t) · bMf (world frame).
+/// afterwards its target is oMd(t) = oMb(t) · bMf (world frame), and its target twist (when
+/// `target_twist` is on) the body twist of two consecutive targets, V_d = (log(R_{k−1}ᵀR_k), R_kᵀ(p_k −
+/// p_{k−1}))/δt, set to zero when it exceeds `max_target_speed` (a jump, not a motion).
+///
+/// Stepping: each mannequin has a Stepper (stepper.hpp): a control::Controller when its setup carries
+/// a controller config (ControllerStepper, the default of the sim service), else the KinematicTracker.
+/// The calibration fit always uses a KinematicTracker (it is an inverse-kinematics problem).
 ///
 /// Occlusion policy (per control frame): while its body is untracked the target holds the last
 /// tracked pose for `occlusion_hold` s, then the frame's weight decreases linearly to 0 over
@@ -20,10 +26,14 @@
 /// is tracked again the weight rises back to 1 over `occlusion_blend` s (no jump).
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
 #include "mannequin/sim/mocap_buffer.hpp"
+#include "mannequin/constraints/joint_limits.hpp"
+#include "mannequin/control/config.hpp"
+#include "mannequin/sim/stepper.hpp"
 #include "mannequin/sim/tracker.hpp"
 #include "mannequin/skeleton/model.hpp"
 
@@ -40,6 +50,9 @@ struct MannequinSetup {
   skeleton::Model model;        ///< built from configs/mannequins/*.yaml by the caller
   std::vector<ControlFrameSpec> frames;
   std::string root_frame = "pelvis";  ///< frame whose body places the mannequin at calibration
+  /// The controller's config (configs/control/*.yaml): steps the mannequin with a ControllerStepper.
+  /// Empty: the KinematicTracker with SimConfig::gains.
+  std::optional<control::ControllerConfig> controller;
 };
 
 struct SimConfig {
@@ -51,7 +64,12 @@ struct SimConfig {
   /// Steps of posture fitting at calibration: q_c is first pulled so that every control frame's origin
   /// reaches its body's position (orientations free), from standing; 0 = use the standing posture as is.
   int calibration_fit_steps = 0;
-  TrackerGains gains;
+  TrackerGains gains;                  ///< KinematicTracker gains (stepper: kinematic, calibration fit)
+  bool target_twist = true;            ///< feed the targets' velocities forward (ControllerStepper)
+  double max_target_speed = 10.0;      ///< m/s (and rad/s × 0.3 m): faster target motion is a jump
+  /// Joint limits as unilateral constraints in the ControllerStepper (nullopt: off). The kinematic
+  /// tracker always clamps to the limits.
+  std::optional<constraints::JointLimitOptions> joint_limits = constraints::JointLimitOptions{};
 };
 
 /// State of one control frame after a step.
@@ -94,6 +112,8 @@ class World {
   const skeleton::VectorX& q(int m) const;
   const skeleton::VectorX& qdot(int m) const;
   bool calibrated(int m) const;
+  /// The mannequin's stepper (kind(), and for a ControllerStepper its controller).
+  const Stepper& stepper(int m) const;
   const std::vector<ControlFrameStatus>& controlFrames(int m) const;
   /// The newest mocap frame added (nullptr before any).
   const MocapInput* latestMocap() const { return buffer_.newest(); }
@@ -102,6 +122,7 @@ class World {
  private:
   struct Mannequin;
   void calibrate(Mannequin& m, const MocapInput& frame);
+  math::Vector6 targetTwist(Mannequin& m, std::size_t i, double dt) const;
   std::vector<std::unique_ptr<Mannequin>> mannequins_;
   SimConfig config_;
   MocapBuffer buffer_;

@@ -25,7 +25,11 @@ struct MannequinEntry {
   std::string config;        ///< configs/mannequins/*.yaml
   std::string root_frame = "pelvis";
   std::vector<sim::ControlFrameSpec> frames;
+  std::string controller = "configs/control/mocap.yaml";  ///< stepper: controller
 };
+
+/// What steps the mannequins: the control library's Controller (default) or the KinematicTracker.
+enum class StepperKind { kController, kKinematic };
 
 struct SimServiceConfig {
   std::string name = "sim";
@@ -35,6 +39,7 @@ struct SimServiceConfig {
   bool publish_on_mocap = false;  ///< also publish sim.world at the first step after each new mocap frame
   double reanchor_threshold = 0.5;  ///< s: live capture clock drifted this far → re-anchor
   sim::SimConfig world;
+  StepperKind stepper = StepperKind::kController;
   std::vector<MannequinEntry> mannequins;
   CollisionSettings collision;
 };

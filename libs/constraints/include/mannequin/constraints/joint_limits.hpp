@@ -1,0 +1,81 @@
+#pragma once
+/// \file joint_limits.hpp
+/// \brief Joint limits as unilateral constraints in the controller's step (thesis 3.7 and Alg. 4, with
+/// constraint rows on the limited coordinates instead of contact normals).
+///
+/// Stage 2 of control::Controller's step, between computeFreeMotion() and integrate(). With q_k, the
+/// free velocity q̇_f (qdotFree), b the apparent friction (its Cholesky factor) and δt the step:
+/// - candidate j: a coordinate with a finite limit that is within `activation` of it, or would pass it,
+///   at q_k + δt q̇_f (revolute: the angle; ball: one component of the rotation vector);
+/// - its row J_j (1 × nv) is the rate of that coordinate: s_j e_jᵀ for a revolute coordinate, s_j times a
+///   row of Jr(q)⁻¹ on the ball's three velocity columns (q̇ = Jr(q)⁻¹ω, ω the body angular velocity);
+///   s_j = +1 for a lower limit, −1 for an upper one, so that J_j q̇ > 0 moves away from the limit;
+/// - distance d_j = s_j (q_j − limit_j) (< 0 past the limit);
+/// - the LCP 0 ≤ w = J_c b⁻¹ J_cᵀ λ + J_c q̇_f + max(d/δt, −v_rec) ⊥ λ ≥ 0 (Lemke, libs/lcp): w_j ≥ 0 keeps
+///   q_{k+1} on the right side of the limit to first order (a coordinate already past it comes back at
+///   `recovery_speed` at most, never with a jump), λ_j ≥ 0 (N·m) only pushes, and only at an active limit;
+/// - Γ_c = J_cᵀ λ goes to Controller::applyConstraintForce (q̇ = q̇_f + b⁻¹Γ_c).
+/// J_c b⁻¹ J_cᵀ is symmetric positive definite for distinct coordinates, so the LCP has one solution.
+/// The forces at the candidates move the other coordinates too (b⁻¹ couples them): a coordinate that
+/// q̇ = q̇_f + b⁻¹J_cᵀλ would carry past its limit joins the candidates and the LCP is solved again
+/// (at most `max_rounds` more times).
+/// Allocates per step in proportion to the number of candidates (none when no limit is near).
+#include <utility>
+#include <vector>
+
+#include "mannequin/control/controller.hpp"
+#include "mannequin/lcp/lemke.hpp"
+
+namespace mannequin::constraints {
+
+struct JointLimitOptions {
+  double activation = 0.05;     ///< rad: candidates are this close to a limit at q_k + δt q̇_f
+  double recovery_speed = 1.0;  ///< rad/s: how fast a coordinate past its limit is brought back
+  int max_rounds = 4;           ///< extra LCP solves when the forces push another coordinate past its limit
+};
+
+/// A limit in the LCP at the last apply().
+struct LimitRow {
+  int coordinate = -1;    ///< index in q
+  bool upper = false;
+  double distance = 0.0;  ///< d_j at q_k (rad; < 0 past the limit)
+  double lambda = 0.0;    ///< generalised force along the row (N·m, ≥ 0)
+};
+
+class JointLimits {
+ public:
+  /// \throws std::invalid_argument on non-finite or negative options.
+  explicit JointLimits(const skeleton::Model& model, JointLimitOptions options = {});
+
+  /// Stage 2 for `ctl` (built on the same model): after computeFreeMotion(), before integrate().
+  /// Returns Solved when nothing is near a limit or the LCP was solved (the force is then applied);
+  /// on any other status nothing is applied and the status is returned (the step goes on unconstrained).
+  lcp::LcpStatus apply(control::Controller& ctl);
+
+  const std::vector<LimitRow>& rows() const { return rows_; }
+  /// Rows with λ > 0 at the last apply().
+  int activeCount() const;
+  long failures() const { return failures_; }
+  const JointLimitOptions& options() const { return options_; }
+
+ private:
+  struct Coordinate {
+    int q = -1, v = -1;     // index in q, first velocity column of its joint
+    int component = -1;     // −1: revolute; 0..2: component of a ball's rotation vector
+    int ball_q = -1;        // first q index of the ball
+    double lower = 0, upper = 0;
+  };
+  double rate(const Coordinate& c, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+  std::vector<Coordinate> coordinates_;
+  std::vector<std::pair<int, bool>> candidates_;  // (coordinate, upper)
+  Eigen::VectorXd qdot_;
+  JointLimitOptions options_;
+  std::vector<LimitRow> rows_;
+  lcp::LemkeWorkspace workspace_;
+  lcp::LcpProblem problem_;
+  Eigen::MatrixXd Jc_, BinvJcT_;
+  Eigen::VectorXd gamma_;
+  long failures_ = 0;
+};
+
+}  // namespace mannequin::constraints

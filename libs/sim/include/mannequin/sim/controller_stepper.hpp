@@ -1,0 +1,73 @@
+#pragma once
+/// \file controller_stepper.hpp
+/// \brief The World's default stepper: one control::Controller (thesis Alg. 2, docs/control.md) per
+/// mannequin, its control frames driven by the World's targets.
+///
+/// Mapping: the World's control frame i is a model frame f_i; it drives the controller's control frame
+/// c_i attached to that model frame (the first in the controller config's list), whose pose is
+/// oMc = oMf · fMc (fMc the config's offset). So the controller's target is oMd · fMc and its target
+/// twist Ad(fMc⁻¹) V_d (body twists). Controller frames that no World frame drives are switched off
+/// (setFrameEnabled(false)): with no mocap body their targets would pin them in the room.
+///
+/// Weight w ∈ [0, 1]: K = w K₀, B = w B₀ (K₀, B₀ from the config, weight applied); w = 0 switches the
+/// frame off, so its rows leave the projectors and the posture control takes the limb (2.25).
+///
+/// The step is the controller's: computeFreeMotion(); the unilateral constraints (today the joint limits,
+/// constraints::JointLimits, an LCP on J_c b⁻¹ J_cᵀ; contacts join with the constraint solver); then
+/// integrate(); then the forward kinematics at q_{k+1} (oMi, oMf, com) for data(). dt must equal the
+/// controller's δt (the constructor sets the controller's δt to the World's step).
+#include <memory>
+#include <vector>
+
+#include <optional>
+
+#include "mannequin/constraints/joint_limits.hpp"
+#include "mannequin/control/controller.hpp"
+#include "mannequin/sim/stepper.hpp"
+
+namespace mannequin::sim {
+
+class ControllerStepper final : public Stepper {
+ public:
+  /// `frames`: model frame indices of the World's control frames; `config.dt` is replaced by `dt`.
+  /// \throws std::invalid_argument if a frame has no controller control frame attached to it (naming the
+  /// frame and listing the controller's frames), or as control::Controller does (names, gains, q0 size).
+  /// `limits`: the joint limits as unilateral constraints (nullopt: none).
+  ControllerStepper(const skeleton::Model& model, control::ControllerConfig config, const std::vector<int>& frames,
+                    double dt, const skeleton::VectorX& q0,
+                    std::optional<constraints::JointLimitOptions> limits = constraints::JointLimitOptions{});
+  void setTarget(int i, const math::SE3& oMd, const math::Vector6& V_d, double weight) override;
+  void setPosture(const skeleton::VectorX& q_posture) override;
+  void reset(const skeleton::VectorX& q) override;
+  bool step(double dt) override;
+  const skeleton::VectorX& q() const override { return controller_->q(); }
+  const skeleton::VectorX& qdot() const override { return controller_->qdot(); }
+  const skeleton::Data& data() const override { return data_; }
+  double portEnergy() const override;
+  std::string_view kind() const override { return "controller"; }
+
+  /// The controller (for its energies, wrenches, stability check, mechanisms).
+  const control::Controller& controller() const { return *controller_; }
+  control::Controller& controller() { return *controller_; }
+  /// Controller control frame driven by the World's control frame i.
+  int controllerFrame(int i) const { return map_.at(i).index; }
+  /// The joint-limit constraints (nullptr when off).
+  const constraints::JointLimits* jointLimits() const { return limits_ ? &*limits_ : nullptr; }
+
+ private:
+  struct Driven {
+    int index = -1;               // controller control frame
+    math::SE3 offset;             // fMc
+    math::SE3 offset_inv;         // cMf
+    math::Vector6 K0, B0;         // gains at weight 1
+    double weight = -1.0;         // last weight applied (−1: none yet)
+  };
+  const skeleton::Model& model_;
+  std::unique_ptr<control::Controller> controller_;
+  std::vector<Driven> map_;
+  std::optional<constraints::JointLimits> limits_;
+  skeleton::Data data_;
+  double dt_;
+};
+
+}  // namespace mannequin::sim

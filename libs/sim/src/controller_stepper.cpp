@@ -1,0 +1,95 @@
+#include "mannequin/sim/controller_stepper.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+#include <string>
+
+namespace mannequin::sim {
+
+ControllerStepper::ControllerStepper(const skeleton::Model& model, control::ControllerConfig config,
+                                     const std::vector<int>& frames, double dt, const skeleton::VectorX& q0,
+                                     std::optional<constraints::JointLimitOptions> limits)
+    : model_(model), data_(model), dt_(dt) {
+  if (limits) limits_.emplace(model, *limits);
+  if (!(dt > 0) || !std::isfinite(dt)) throw std::invalid_argument("controller stepper: step must be > 0");
+  config.dt = dt;
+  controller_ = std::make_unique<control::Controller>(model, config, q0);
+  std::vector<bool> used(controller_->numFrames(), false);
+  for (int f : frames) {
+    if (f < 0 || f >= static_cast<int>(model.frames.size()))
+      throw std::invalid_argument("controller stepper: bad model frame index " + std::to_string(f));
+    Driven d;
+    for (int c = 0; c < controller_->numFrames(); ++c)
+      if (!used[c] && controller_->frame(c).frame == f) {
+        d.index = c;
+        break;
+      }
+    if (d.index < 0) {
+      std::string list;
+      for (int c = 0; c < controller_->numFrames(); ++c)
+        list += (c ? ", " : "") + controller_->frame(c).name + " (on " + model.frames[controller_->frame(c).frame].name + ")";
+      throw std::invalid_argument("controller config " + (config.source.empty() ? std::string("(inline)") : config.source) +
+                                  ": no control frame on model frame '" + model.frames[f].name +
+                                  "' for the mocap body that drives it (control frames: " + list + ")");
+    }
+    used[d.index] = true;
+    const control::ControlFrameState& s = controller_->frame(d.index);
+    d.offset = s.offset;
+    d.offset_inv = s.offset.inverse();
+    d.K0 = s.stiffness;
+    d.B0 = s.damping;
+    map_.push_back(d);
+  }
+  // frames no mocap body drives would pin their segment where it stood: off
+  for (int c = 0; c < controller_->numFrames(); ++c)
+    if (!used[c]) controller_->setFrameEnabled(c, false);
+  skeleton::forwardKinematics(model_, data_, controller_->q());
+  skeleton::centerOfMass(model_, data_);
+}
+
+void ControllerStepper::setTarget(int i, const math::SE3& oMd, const math::Vector6& V_d, double weight) {
+  Driven& d = map_.at(i);
+  if (!std::isfinite(weight) || !V_d.allFinite() || !oMd.R.allFinite() || !oMd.p.allFinite()) return;
+  const double w = std::clamp(weight, 0.0, 1.0);
+  if (w != d.weight) {
+    controller_->setGains(d.index, w * d.K0, w * d.B0);
+    controller_->setFrameEnabled(d.index, w > 0.0);
+    d.weight = w;
+  }
+  try {
+    controller_->setTarget(d.index, oMd * d.offset, math::actTwist(d.offset_inv, V_d));
+  } catch (const std::invalid_argument&) {
+    // not a rotation: the previous target stays (the controller keeps it)
+  }
+}
+
+double ControllerStepper::portEnergy() const {
+  double e = 0.0;
+  for (int c = 0; c < controller_->numFrames(); ++c) e += controller_->frame(c).port.energy;
+  return e;
+}
+
+void ControllerStepper::setPosture(const skeleton::VectorX& q_posture) { controller_->setPosture(q_posture); }
+
+void ControllerStepper::reset(const skeleton::VectorX& q) {
+  controller_->reset(q);
+  skeleton::forwardKinematics(model_, data_, controller_->q());
+  skeleton::centerOfMass(model_, data_);
+}
+
+bool ControllerStepper::step(double dt) {
+  if (std::abs(dt - dt_) > 1e-12 * dt_)
+    throw std::logic_error("controller stepper: step " + std::to_string(dt) + " s, built for " + std::to_string(dt_) + " s");
+  if (controller_->computeFreeMotion() != control::StepStatus::kOk) return false;
+  // unilateral constraints (Alg. 4): their force joins q̇ before the integration; a failed LCP leaves
+  // the step unconstrained (counted in jointLimits()->failures())
+  if (limits_) limits_->apply(*controller_);
+  controller_->integrate();
+  if (!controller_->q().allFinite()) return false;
+  skeleton::forwardKinematics(model_, data_, controller_->q());
+  skeleton::centerOfMass(model_, data_);
+  return true;
+}
+
+}  // namespace mannequin::sim
