@@ -141,7 +141,7 @@ TEST(SimConfig, ErrorsNameFileLineAndField) {
       simservice::parseSimConfig(service::ConfigNode::parse(yaml, "sim.yaml"));
       ADD_FAILURE() << "no error for\n" << yaml;
     } catch (const service::ConfigError& e) {
-      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << "got: " << e.what();
     }
   };
   const std::string m = "mannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, control_frames: {hand_l: hand_l}}\n";
@@ -151,6 +151,19 @@ TEST(SimConfig, ErrorsNameFileLineAndField) {
   expectError("gains: {task: 2000}\n" + m, "task * step must be < 1");
   expectError("colision: {}\n" + m, "sim.yaml:1: field 'colision': unknown key");
   expectError("mannequins: []\n", "no mannequin");
+  expectError("stepper: dynamic\n" + m, "sim.yaml:1: field 'stepper': expected controller or kinematic");
+  expectError("joint_limits: {activation: -1}\n" + m, "field 'joint_limits.activation': -1 is outside [0, 1]");
+  expectError("target_twist: {max_speed: nan}\n" + m, "field 'target_twist.max_speed': 'nan' is not a finite number");
+  // a missing controller config is named with the mannequin
+  try {
+    simservice::buildMannequins(simservice::parseSimConfig(service::ConfigNode::parse(
+        "mannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, controller: configs/control/nope.yaml, "
+        "control_frames: {hand_l: hand_l}}\n", "s")));
+    ADD_FAILURE() << "no error for a missing controller config";
+  } catch (const service::ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("mannequin 'a': controller:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("nope.yaml"), std::string::npos) << e.what();
+  }
   const auto c = simservice::loadSimConfig("configs/sim/sim_demo.yaml");
   EXPECT_EQ(c.mannequins.size(), 1u);
   EXPECT_EQ(c.mannequins[0].frames.size(), 6u);
