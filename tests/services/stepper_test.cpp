@@ -13,6 +13,7 @@
 #include "mannequin/math/so3.hpp"
 #include "mannequin/mocap/source.hpp"
 #include "mannequin/service/config.hpp"
+#include "mannequin/simservice/messages.hpp"
 #include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
@@ -235,11 +236,8 @@ CaptureRun runCapture(bool controller) {
   while (!source->finished()) {
     const auto s = source->next(std::chrono::microseconds(0));
     if (!s) continue;
-    MocapInput in;
-    in.stamp_ns = s->stamp_ns;
-    in.frame_number = s->frame_number;
-    in.calibration_pose = s->calibration_pose;
-    for (const mocap::Body& b : s->bodies) in.bodies.push_back({b.name, b.pose, b.tracked});
+    // as the cluster carries it: the mocap service's message, decoded by the sim service
+    const MocapInput in = simservice::toInput(mocap::toMessage(*s, source->kind()));
     w.addMocap(in);
     if (!w.anchored()) w.anchor(in.stamp_ns);
     while (w.captureTimeNs() < in.stamp_ns) {

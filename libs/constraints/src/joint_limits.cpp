@@ -38,9 +38,12 @@ int JointLimits::activeCount() const {
   return n;
 }
 
-double JointLimits::rate(const Coordinate& c, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const {
-  if (c.component < 0) return qdot(c.v);
-  return math::rightJacobianInverseSO3(q.segment<3>(c.ball_q)).row(c.component).dot(qdot.segment<3>(c.v));
+Eigen::RowVector3d JointLimits::ballRow(const Coordinate& c, const Eigen::VectorXd& q) {
+  return math::rightJacobianInverseSO3(q.segment<3>(c.ball_q)).row(c.component);  // q̇ = Jr(q)⁻¹ω
+}
+
+double JointLimits::rate(const Coordinate& c, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) {
+  return c.component < 0 ? qdot(c.v) : ballRow(c, q).dot(qdot.segment<3>(c.v));
 }
 
 lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
@@ -72,7 +75,7 @@ lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
       if (c.component < 0)
         Jc_(r, c.v) = s;
       else
-        Jc_.block<1, 3>(r, c.v) = s * math::rightJacobianInverseSO3(q.segment<3>(c.ball_q)).row(c.component);
+        Jc_.block<1, 3>(r, c.v) = s * ballRow(c, q);
       const double d = upper ? c.upper - q(c.q) : q(c.q) - c.lower;
       problem_.q(r) = Jc_.row(r).dot(qdot_f) + std::max(d / dt, -options_.recovery_speed);
     }

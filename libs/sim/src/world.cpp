@@ -17,7 +17,7 @@ struct World::Mannequin {
   std::vector<ControlFrameSpec> specs;
   int root_frame = -1;
   std::vector<int> frame_indices;
-  std::unique_ptr<Stepper> tracker;
+  std::unique_ptr<Stepper> stepper;
   std::vector<ControlFrameStatus> frames;
   std::vector<math::SE3> previous_targets;  // targets of the previous step (target twist)
   std::vector<bool> have_previous;
@@ -54,17 +54,17 @@ World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : conf
     m->frame_indices = idx;
     if (s.controller) {
       try {
-        m->tracker = std::make_unique<ControllerStepper>(m->model, *s.controller, idx, config_.step, m->q_standing,
+        m->stepper = std::make_unique<ControllerStepper>(m->model, *s.controller, idx, config_.step, m->q_standing,
                                                          config_.joint_limits);
       } catch (const std::invalid_argument& e) {
         throw std::invalid_argument("sim: mannequin '" + s.name + "': " + e.what());
       }
     } else {
-      m->tracker = std::make_unique<KinematicTracker>(m->model, idx, config_.gains, m->q_standing);
+      m->stepper = std::make_unique<KinematicTracker>(m->model, idx, config_.gains, m->q_standing);
     }
     m->previous_targets.resize(idx.size());
     m->have_previous.assign(idx.size(), false);
-    for (auto& st : m->frames) st.target = st.actual = m->tracker->data().oMf[st.frame_index];
+    for (auto& st : m->frames) st.target = st.actual = m->stepper->data().oMf[st.frame_index];
     mannequins_.push_back(std::move(m));
   }
 }
@@ -73,11 +73,11 @@ World::~World() = default;
 
 const std::string& World::name(int m) const { return mannequins_.at(m)->name; }
 const skeleton::Model& World::model(int m) const { return mannequins_.at(m)->model; }
-const skeleton::Data& World::data(int m) const { return mannequins_.at(m)->tracker->data(); }
-const skeleton::VectorX& World::q(int m) const { return mannequins_.at(m)->tracker->q(); }
-const skeleton::VectorX& World::qdot(int m) const { return mannequins_.at(m)->tracker->qdot(); }
+const skeleton::Data& World::data(int m) const { return mannequins_.at(m)->stepper->data(); }
+const skeleton::VectorX& World::q(int m) const { return mannequins_.at(m)->stepper->q(); }
+const skeleton::VectorX& World::qdot(int m) const { return mannequins_.at(m)->stepper->qdot(); }
 bool World::calibrated(int m) const { return mannequins_.at(m)->calibrated; }
-const Stepper& World::stepper(int m) const { return *mannequins_.at(m)->tracker; }
+const Stepper& World::stepper(int m) const { return *mannequins_.at(m)->stepper; }
 const std::vector<ControlFrameStatus>& World::controlFrames(int m) const { return mannequins_.at(m)->frames; }
 
 void World::anchor(std::int64_t capture_ns) {
@@ -133,10 +133,10 @@ void World::calibrate(Mannequin& m, const MocapInput& frame) {
     }
     qc = fit.q();
   }
-  m.tracker->reset(qc);
-  m.tracker->setPosture(qc);
+  m.stepper->reset(qc);
+  m.stepper->setPosture(qc);
   std::fill(m.have_previous.begin(), m.have_previous.end(), false);
-  const skeleton::Data& d = m.tracker->data();
+  const skeleton::Data& d = m.stepper->data();
   for (auto& st : m.frames) {
     const BodyInput* b = find(st.body);
     st.offset = b->pose.inverse() * d.oMf[st.frame_index];
@@ -194,17 +194,17 @@ bool World::step() {
         const double rate = dt / std::max(config_.occlusion_blend, 1e-9);
         double& w = m.weights[i];
         w = goal > w ? std::min(goal, w + rate) : goal;
-        m.tracker->setTarget(static_cast<int>(i), st.target, targetTwist(m, i, dt), w);
+        m.stepper->setTarget(static_cast<int>(i), st.target, targetTwist(m, i, dt), w);
       }
     } else {
       for (std::size_t i = 0; i < m.frames.size(); ++i)
-        m.tracker->setTarget(static_cast<int>(i), m.frames[i].target, math::Vector6::Zero(), 0.0);
+        m.stepper->setTarget(static_cast<int>(i), m.frames[i].target, math::Vector6::Zero(), 0.0);
     }
-    if (!m.tracker->step(dt)) {
+    if (!m.stepper->step(dt)) {
       ok = false;
       ++failed_steps_;
     }
-    const skeleton::Data& d = m.tracker->data();
+    const skeleton::Data& d = m.stepper->data();
     for (std::size_t i = 0; i < m.frames.size(); ++i) {
       ControlFrameStatus& st = m.frames[i];
       st.actual = d.oMf[st.frame_index];

@@ -65,7 +65,9 @@ class JointLimits {
     int ball_q = -1;        // first q index of the ball
     double lower = 0, upper = 0;
   };
-  double rate(const Coordinate& c, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot) const;
+  /// Rate of coordinate c under the velocity qdot, and (ball) its row on the joint's 3 velocity columns.
+  static double rate(const Coordinate& c, const Eigen::VectorXd& q, const Eigen::VectorXd& qdot);
+  static Eigen::RowVector3d ballRow(const Coordinate& c, const Eigen::VectorXd& q);
   std::vector<Coordinate> coordinates_;
   std::vector<std::pair<int, bool>> candidates_;  // (coordinate, upper)
   Eigen::VectorXd qdot_;
