@@ -6,18 +6,8 @@
 #include <cstddef>
 
 #include "common.hpp"
+#include "../common/alloc_counter.hpp"
 
-#if !defined(__SANITIZE_ADDRESS__)
-namespace {
-long g_allocations = 0;
-bool g_counting = false;
-}  // namespace
-extern "C" void* __libc_malloc(std::size_t size);
-extern "C" void* malloc(std::size_t size) {
-  if (g_counting) ++g_allocations;
-  return __libc_malloc(size);
-}
-#endif
 
 using namespace mannequin;
 using namespace mannequin::control;
@@ -43,18 +33,17 @@ TEST(ControlAlloc, StepAllocatesNothing) {
     gamma_c(2) = 10.0;
     SE3 target = ctl.frame(ctl.frameIndex("hand_l")).pose;
     ctl.step();  // warm-up
-    g_allocations = 0;
-    g_counting = true;
-    for (int i = 0; i < 50; ++i) {
-      target.p.x() += 1e-4;
-      ctl.setTarget(ctl.frameIndex("hand_l"), target);
-      ctl.computeFreeMotion();
-      ctl.applyConstraintForce(gamma_c);
-      ctl.integrate();
-      ctl.step();
-    }
-    g_counting = false;
-    EXPECT_EQ(g_allocations, 0) << toString(method);
+    const long allocations = countAllocations([&] {
+      for (int i = 0; i < 50; ++i) {
+        target.p.x() += 1e-4;
+        ctl.setTarget(ctl.frameIndex("hand_l"), target);
+        ctl.computeFreeMotion();
+        ctl.applyConstraintForce(gamma_c);
+        ctl.integrate();
+        ctl.step();
+      }
+    });
+    EXPECT_EQ(allocations, 0) << toString(method);
   }
 #endif
 }

@@ -9,38 +9,9 @@
 #include "mannequin/lcp/pgs.hpp"
 #include "mannequin/lcp/structured.hpp"
 #include "mannequin/lcp/testing.hpp"
-
-#if !defined(__SANITIZE_ADDRESS__)
-namespace {
-long g_allocations = 0;
-bool g_counting = false;
-}  // namespace
-extern "C" void* __libc_malloc(std::size_t size);
-extern "C" void* malloc(std::size_t size) {
-  if (g_counting) ++g_allocations;
-  return __libc_malloc(size);
-}
-#endif
+#include "../common/alloc_counter.hpp"
 
 using namespace mannequin::lcp;
-
-namespace {
-
-template <class F>
-long countAllocations(F&& f) {
-#if !defined(__SANITIZE_ADDRESS__)
-  g_allocations = 0;
-  g_counting = true;
-  f();
-  g_counting = false;
-  return g_allocations;
-#else
-  f();
-  return -1;
-#endif
-}
-
-}  // namespace
 
 TEST(Allocation, LemkeDoesNotAllocatePerPivot) {
 #if defined(__SANITIZE_ADDRESS__)
