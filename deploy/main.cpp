@@ -8,7 +8,7 @@
 #include <iostream>
 
 #include "mannequin/deploy/supervisor.hpp"
-#include "mannequin/service/config.hpp"
+#include "mannequin/core/config.hpp"
 #include "mannequin/service/runtime.hpp"
 
 using namespace mannequin;

@@ -7,12 +7,12 @@
 #include <sstream>
 #include <stdexcept>
 
-#include "mannequin/service/config.hpp"
+#include "mannequin/core/config.hpp"
 #include "mannequin/transport/publisher.hpp"
 
 namespace mannequin::deploy {
 
-using service::ConfigNode;
+using core::ConfigNode;
 
 std::string expandRunDir(const std::string& text, const std::string& run_dir) {
   std::string out = text;
@@ -112,7 +112,7 @@ Deployment parseDeployment(const std::string& yaml, const std::string& source, c
 Deployment loadDeployment(const std::string& path, const std::string& run_dir) {
   // read via ConfigNode for the error messages of an unreadable file
   std::ifstream in(path);
-  if (!in) throw service::ConfigError(path + ":0: cannot read the file");
+  if (!in) throw core::ConfigError(path + ":0: cannot read the file");
   std::stringstream ss;
   ss << in.rdbuf();
   return parseDeployment(ss.str(), path, run_dir);

@@ -8,7 +8,7 @@
 #include <map>
 
 #include "mannequin/collision/world.hpp"
-#include "mannequin/service/config.hpp"
+#include "mannequin/core/config.hpp"
 #include "mannequin/service/runtime.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
@@ -43,7 +43,7 @@ int main(int argc, char** argv) {
   try {
     service::setupLogging(common.log_level);
     const auto& stop = service::installStopSignals();
-    const service::ConfigNode config = service::ConfigNode::load(common.config);
+    const core::ConfigNode config = core::ConfigNode::load(common.config);
     config.allowOnly({"name", "publish", "connect", "scene", "activation_distance", "mannequins"});
     const std::string name = common.name.empty() ? config.get("name", std::string("collision")) : common.name;
     std::vector<std::string> publish = common.publish, connect = common.connect;
@@ -61,7 +61,7 @@ int main(int argc, char** argv) {
       }
     }
     std::vector<MannequinSlot> mannequins;
-    for (const service::ConfigNode& m : config["mannequins"].items()) {
+    for (const core::ConfigNode& m : config["mannequins"].items()) {
       m.allowOnly({"name", "config", "margin", "self_collision"});
       MannequinSlot slot;
       slot.name = m["name"].str();

@@ -38,14 +38,14 @@ int main(int argc, char** argv) {
   try {
     service::setupLogging(common.log_level);
     const auto& stop = service::installStopSignals();
-    (void)service::ConfigNode::load(common.config);  // syntax errors with their line
+    (void)core::ConfigNode::load(common.config);  // syntax errors with their line
     YAML::Node raw = YAML::LoadFile(common.config);  // command-line overrides are applied to the tree
     if (!source_override.empty()) raw["source"] = source_override;
     if (!bvh_override.empty()) raw["bvh"]["file"] = bvh_override;
     if (rate > 0) raw["bvh"]["rate"] = rate;
     if (loop) raw["bvh"]["loop"] = true;
     if (no_loop) raw["bvh"]["loop"] = false;
-    const service::ConfigNode config(raw, common.config);
+    const core::ConfigNode config(raw, common.config);
     config.allowOnly({"name", "publish", "source", "bvh", "synthetic", "dtrack2"});
     std::vector<std::string> publish = common.publish;
     if (publish.empty()) publish = config["publish"].strings();

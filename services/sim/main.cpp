@@ -29,11 +29,11 @@ int main(int argc, char** argv) {
     YAML::Node raw = YAML::LoadFile(common.config);
     if (!mode.empty()) raw["mode"] = mode;
     if (world_rate > 0) raw["world_rate"] = world_rate;
-    simservice::SimServiceConfig config = simservice::parseSimConfig(service::ConfigNode(raw, common.config));
+    simservice::SimServiceConfig config = simservice::parseSimConfig(core::ConfigNode(raw, common.config));
     if (!common.name.empty()) config.name = common.name;
     if (!common.publish.empty()) config.publish = common.publish;
     if (!common.connect.empty()) config.connect = common.connect;
-    if (config.publish.empty()) throw service::ConfigError(common.config + ": no publish endpoint (config 'publish' or --publish)");
+    if (config.publish.empty()) throw core::ConfigError(common.config + ": no publish endpoint (config 'publish' or --publish)");
     zmq::context_t context;
     simservice::SimService service(config, context, common.heartbeat_period);
     return service.run(stop, common.duration);

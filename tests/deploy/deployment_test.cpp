@@ -2,7 +2,7 @@
 #include <gtest/gtest.h>
 
 #include "mannequin/deploy/deployment.hpp"
-#include "mannequin/service/config.hpp"
+#include "mannequin/core/config.hpp"
 
 using namespace mannequin::deploy;
 
@@ -43,7 +43,7 @@ TEST(Deployment, ErrorsNameFileLineAndField) {
     try {
       parseDeployment(yaml, "d.yaml");
       ADD_FAILURE() << "no error for\n" << yaml;
-    } catch (const mannequin::service::ConfigError& e) {
+    } catch (const mannequin::core::ConfigError& e) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
     }
   };

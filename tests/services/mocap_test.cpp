@@ -28,7 +28,7 @@ math::Matrix3 rx(double d) { return math::expSO3(math::Vector3(d * M_PI / 180, 0
 math::Matrix3 ry(double d) { return math::expSO3(math::Vector3(0, d * M_PI / 180, 0)); }
 math::Matrix3 rz(double d) { return math::expSO3(math::Vector3(0, 0, d * M_PI / 180)); }
 
-service::ConfigNode configOf(const std::string& text) { return service::ConfigNode::parse(text, "test.yaml"); }
+core::ConfigNode configOf(const std::string& text) { return core::ConfigNode::parse(text, "test.yaml"); }
 }  // namespace
 
 TEST(DTrack2, ParsesARealDatagram) {
@@ -218,7 +218,7 @@ TEST(MocapConfig, BuildsSourcesAndNamesFileLineAndField) {
     try {
       makeSource(configOf(yaml));
       ADD_FAILURE() << "no error for\n" << yaml;
-    } catch (const service::ConfigError& e) {
+    } catch (const core::ConfigError& e) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
     }
   };
@@ -232,5 +232,5 @@ TEST(MocapConfig, BuildsSourcesAndNamesFileLineAndField) {
   expectError("source: synthetic\nsynthetic:\n  rate_hz: abc\n  bodies: []\n", "field 'synthetic.rate_hz': 'abc' is not a number");
   expectError("source: synthetic\nsynthetic:\n  bodies:\n    - {name: a, center: [0, 0]}\n", "expected [x, y, z]");
   expectError("source: dtrack2\ndtrack2:\n  port: 99999\n  bodies: {0: head}\n", "field 'dtrack2.port'");
-  EXPECT_THROW(service::ConfigNode::parse("a: [1, 2\n", "bad.yaml"), service::ConfigError);
+  EXPECT_THROW(core::ConfigNode::parse("a: [1, 2\n", "bad.yaml"), core::ConfigError);
 }

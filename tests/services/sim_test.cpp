@@ -138,9 +138,9 @@ TEST(World, RejectsUnknownFrames) {
 TEST(SimConfig, ErrorsNameFileLineAndField) {
   auto expectError = [](const std::string& yaml, const std::string& what) {
     try {
-      simservice::parseSimConfig(service::ConfigNode::parse(yaml, "sim.yaml"));
+      simservice::parseSimConfig(core::ConfigNode::parse(yaml, "sim.yaml"));
       ADD_FAILURE() << "no error for\n" << yaml;
-    } catch (const service::ConfigError& e) {
+    } catch (const core::ConfigError& e) {
       EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << "got: " << e.what();
     }
   };
@@ -156,20 +156,20 @@ TEST(SimConfig, ErrorsNameFileLineAndField) {
   expectError("target_twist: {max_speed: nan}\n" + m, "field 'target_twist.max_speed': 'nan' is not a finite number");
   // a missing controller config is named with the mannequin
   try {
-    simservice::buildMannequins(simservice::parseSimConfig(service::ConfigNode::parse(
+    simservice::buildMannequins(simservice::parseSimConfig(core::ConfigNode::parse(
         "mannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, controller: configs/control/nope.yaml, "
         "control_frames: {hand_l: hand_l}}\n", "s")));
     ADD_FAILURE() << "no error for a missing controller config";
-  } catch (const service::ConfigError& e) {
+  } catch (const core::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("mannequin 'a': controller:"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("nope.yaml"), std::string::npos) << e.what();
   }
   const auto c = simservice::loadSimConfig("configs/sim/sim_demo.yaml");
   EXPECT_EQ(c.mannequins.size(), 1u);
   EXPECT_EQ(c.mannequins[0].frames.size(), 6u);
-  EXPECT_THROW(simservice::buildMannequins(simservice::parseSimConfig(service::ConfigNode::parse(
+  EXPECT_THROW(simservice::buildMannequins(simservice::parseSimConfig(core::ConfigNode::parse(
                    "mannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, control_frames: {wing: x}}\n", "s"))),
-               service::ConfigError);
+               core::ConfigError);
 }
 
 namespace {

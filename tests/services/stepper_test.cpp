@@ -12,7 +12,7 @@
 #include "mannequin/control/config.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/mocap/source.hpp"
-#include "mannequin/service/config.hpp"
+#include "mannequin/core/config.hpp"
 #include "mannequin/simservice/messages.hpp"
 #include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/sim/world.hpp"
@@ -223,7 +223,7 @@ CaptureRun runCapture(bool controller) {
   YAML::Node raw = YAML::LoadFile("configs/sim/mocap_demo.yaml");
   raw["bvh"]["paced"] = false;
   raw["bvh"]["loop"] = false;
-  auto source = mocap::makeSource(service::ConfigNode(raw, "configs/sim/mocap_demo.yaml"));
+  auto source = mocap::makeSource(core::ConfigNode(raw, "configs/sim/mocap_demo.yaml"));
   MannequinSetup m;
   m.name = "operator";
   m.model = male50();

@@ -12,7 +12,7 @@ namespace mannequin::tools {
 
 /// Publish endpoints of the deployment file's services (deploy::loadDeployment, ${RUN_DIR}
 /// expanded with run_dir, "" = the file's default): `names` empty = every service, else the named
-/// ones. \throws service::ConfigError "FILE:LINE: ..." for a bad file, std::runtime_error naming
+/// ones. \throws core::ConfigError "FILE:LINE: ..." for a bad file, std::runtime_error naming
 /// an unknown service (with the deployment's services).
 std::vector<std::string> publishEndpoints(const std::string& deployment_file, const std::string& run_dir,
                                           const std::vector<std::string>& names = {});

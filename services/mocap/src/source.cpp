@@ -13,7 +13,7 @@
 
 namespace mannequin::mocap {
 
-using service::ConfigNode;
+using core::ConfigNode;
 
 bool sleepUntil(std::int64_t deadline_ns, std::chrono::microseconds max_wait) {
   const std::int64_t now = transport::steadyNs();

@@ -4,7 +4,7 @@
 
 namespace mannequin::simservice {
 
-using service::ConfigNode;
+using core::ConfigNode;
 
 SimServiceConfig parseSimConfig(const ConfigNode& root) {
   root.allowOnly({"name", "publish", "connect", "mode", "step", "world_rate", "publish_on_mocap", "interpolation_delay",
@@ -118,13 +118,13 @@ std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config)
       if (s.model.findFrame(f.frame) < 0) {
         std::string list;
         for (const auto& fr : s.model.frames) list += (list.empty() ? "" : ", ") + fr.name;
-        throw service::ConfigError("mannequin '" + e.name + "': no frame '" + f.frame + "' in " + e.config + " (frames: " + list + ")");
+        throw core::ConfigError("mannequin '" + e.name + "': no frame '" + f.frame + "' in " + e.config + " (frames: " + list + ")");
       }
     if (config.stepper == StepperKind::kController) {
       try {
         s.controller = control::loadControllerConfig(e.controller);
       } catch (const std::exception& ex) {
-        throw service::ConfigError("mannequin '" + e.name + "': controller: " + ex.what());
+        throw core::ConfigError("mannequin '" + e.name + "': controller: " + ex.what());
       }
     }
     out.push_back(std::move(s));

@@ -46,7 +46,7 @@ struct Deployment {
 };
 
 /// Reads a deployment file. `run_dir` ("" = the file's `run_dir`, else /tmp/mannequin-<name>-<uid>)
-/// replaces ${RUN_DIR}. \throws service::ConfigError "FILE:LINE: field '...': ..." (unknown keys,
+/// replaces ${RUN_DIR}. \throws core::ConfigError "FILE:LINE: field '...': ..." (unknown keys,
 /// duplicate names, a connect naming no service, a service without publish endpoint, bad numbers).
 Deployment loadDeployment(const std::string& path, const std::string& run_dir = {});
 Deployment parseDeployment(const std::string& yaml, const std::string& source, const std::string& run_dir = {});

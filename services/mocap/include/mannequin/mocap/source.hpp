@@ -12,7 +12,7 @@
 #include <mannequin/v1/mocap.pb.h>
 
 #include "mannequin/math/se3.hpp"
-#include "mannequin/service/config.hpp"
+#include "mannequin/core/config.hpp"
 
 namespace mannequin::mocap {
 
@@ -48,8 +48,8 @@ class Source {
 };
 
 /// Builds the source the config names (key `source`, and its section). See docs/cluster.md.
-/// \throws service::ConfigError naming FILE:LINE and the field.
-std::unique_ptr<Source> makeSource(const service::ConfigNode& config);
+/// \throws core::ConfigError naming FILE:LINE and the field.
+std::unique_ptr<Source> makeSource(const core::ConfigNode& config);
 
 /// The MocapFrame of a sample (header.stamp_ns = capture time; the publisher fills the rest).
 v1::MocapFrame toMessage(const Sample& sample, const std::string& kind);

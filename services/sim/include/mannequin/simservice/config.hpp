@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "mannequin/service/config.hpp"
+#include "mannequin/core/config.hpp"
 #include "mannequin/sim/world.hpp"
 
 namespace mannequin::simservice {
@@ -44,11 +44,11 @@ struct SimServiceConfig {
   CollisionSettings collision;
 };
 
-/// \throws service::ConfigError "FILE:LINE: field '...': ...".
-SimServiceConfig parseSimConfig(const service::ConfigNode& root);
+/// \throws core::ConfigError "FILE:LINE: field '...': ...".
+SimServiceConfig parseSimConfig(const core::ConfigNode& root);
 SimServiceConfig loadSimConfig(const std::string& path);
 
-/// Builds the World's mannequins (loads every mannequin config). \throws service::ConfigError.
+/// Builds the World's mannequins (loads every mannequin config). \throws core::ConfigError.
 std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config);
 
 }  // namespace mannequin::simservice

@@ -32,7 +32,7 @@ struct SimStats {
 
 class SimService {
  public:
-  /// Builds the World and binds/connects. \throws service::ConfigError, std::runtime_error.
+  /// Builds the World and binds/connects. \throws core::ConfigError, std::runtime_error.
   SimService(const SimServiceConfig& config, zmq::context_t& context, double heartbeat_period = 0.5);
   ~SimService();
   /// Runs until `stop` or `duration` seconds (0 = no limit). Returns 0.

@@ -1,6 +1,7 @@
 #pragma once
 /// \file config.hpp
-/// \brief YAML config reading for services and the launcher: every error names FILE:LINE and the field.
+/// \brief The one YAML config reader of every library, service and tool: every error names FILE:LINE and
+/// the field, unknown keys are refused with allowOnly().
 #include <optional>
 #include <stdexcept>
 #include <string>
@@ -8,9 +9,9 @@
 
 #include <yaml-cpp/yaml.h>
 
-#include "mannequin/math/se3.hpp"
+#include <Eigen/Core>
 
-namespace mannequin::service {
+namespace mannequin::core {
 
 /// A bad config: what() is "FILE:LINE: field 'a.b': message".
 class ConfigError : public std::runtime_error {
@@ -46,7 +47,7 @@ class ConfigNode {
   double num() const;            ///< finite number
   long long integer() const;
   bool boolean() const;
-  math::Vector3 vec3() const;    ///< [x, y, z]
+  Eigen::Vector3d vec3() const;    ///< [x, y, z]
   std::vector<std::string> strings() const;  ///< a scalar or a sequence of scalars
 
   /// Value of `key` or `fallback` when absent.
@@ -72,4 +73,4 @@ class ConfigNode {
   std::string path_;
 };
 
-}  // namespace mannequin::service
+}  // namespace mannequin::core

@@ -1,4 +1,4 @@
-#include "mannequin/service/config.hpp"
+#include "mannequin/core/config.hpp"
 
 #include <fmt/format.h>
 
@@ -6,7 +6,7 @@
 #include <fstream>
 #include <sstream>
 
-namespace mannequin::service {
+namespace mannequin::core {
 
 ConfigNode ConfigNode::load(const std::string& path) {
   std::ifstream in(path);
@@ -98,7 +98,7 @@ bool ConfigNode::boolean() const {
   fail("'" + s + "' is not true/false");
 }
 
-math::Vector3 ConfigNode::vec3() const {
+Eigen::Vector3d ConfigNode::vec3() const {
   const auto it = items();
   if (it.size() != 3) fail(fmt::format("expected [x, y, z], got {} values", it.size()));
   return {it[0].num(), it[1].num(), it[2].num()};
@@ -150,4 +150,4 @@ void ConfigNode::allowOnly(const std::vector<std::string>& allowed) const {
   }
 }
 
-}  // namespace mannequin::service
+}  // namespace mannequin::core
