@@ -2,9 +2,8 @@
 
 #include <unistd.h>
 
-#include <fstream>
+#include <limits>
 #include <set>
-#include <sstream>
 #include <stdexcept>
 
 #include "mannequin/core/config.hpp"
@@ -43,30 +42,20 @@ namespace {
 RestartOptions parseRestart(const ConfigNode& n, RestartOptions r) {
   n.allowOnly({"policy", "max_restarts", "backoff_initial", "backoff_max", "stable_after"});
   if (auto p = n.find("policy")) {
-    const std::string v = p->str();
-    if (v == "never")
-      r.policy = RestartPolicy::kNever;
-    else if (v == "on-failure")
-      r.policy = RestartPolicy::kOnFailure;
-    else if (v == "always")
-      r.policy = RestartPolicy::kAlways;
-    else
-      p->fail("expected never, on-failure or always");
+    static const RestartPolicy kPolicies[] = {RestartPolicy::kNever, RestartPolicy::kOnFailure, RestartPolicy::kAlways};
+    r.policy = kPolicies[p->choice({"never", "on-failure", "always"})];
   }
-  r.max_restarts = static_cast<int>(n.get("max_restarts", static_cast<long long>(r.max_restarts)));
-  if (r.max_restarts < 0) n["max_restarts"].fail("must be >= 0");
+  if (auto m = n.find("max_restarts")) r.max_restarts = static_cast<int>(m->integerIn(0, std::numeric_limits<int>::max()));
   r.backoff_initial = n.getIn("backoff_initial", r.backoff_initial, 0.0, 3600.0);
   r.backoff_max = n.getIn("backoff_max", r.backoff_max, 0.0, 3600.0);
   r.stable_after = n.getIn("stable_after", r.stable_after, 0.0, 1e6);
   return r;
 }
-}  // namespace
 
-Deployment parseDeployment(const std::string& yaml, const std::string& source, const std::string& run_dir) {
-  const ConfigNode root = ConfigNode::parse(yaml, source);
+Deployment readDeployment(const ConfigNode& root, const std::string& run_dir) {
   root.allowOnly({"name", "run_dir", "heartbeat_timeout", "stop_timeout", "restart", "services"});
   Deployment d;
-  d.source = source;
+  d.source = root.file();
   d.name = root["name"].str();
   d.run_dir = run_dir;
   if (d.run_dir.empty()) d.run_dir = root.get("run_dir", std::string());
@@ -108,14 +97,14 @@ Deployment parseDeployment(const std::string& yaml, const std::string& source, c
       if (!names.count(c)) items[i]["connect"].fail("no service named '" + c + "' in this deployment");
   return d;
 }
+}  // namespace
+
+Deployment parseDeployment(const std::string& yaml, const std::string& source, const std::string& run_dir) {
+  return readDeployment(ConfigNode::parse(yaml, source), run_dir);
+}
 
 Deployment loadDeployment(const std::string& path, const std::string& run_dir) {
-  // read via ConfigNode for the error messages of an unreadable file
-  std::ifstream in(path);
-  if (!in) throw core::ConfigError(path + ":0: cannot read the file");
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return parseDeployment(ss.str(), path, run_dir);
+  return readDeployment(ConfigNode::load(path), run_dir);
 }
 
 }  // namespace mannequin::deploy

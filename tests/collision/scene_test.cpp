@@ -9,6 +9,7 @@
 #include "test_util.hpp"
 
 using namespace mannequin::collision;
+using mannequin::core::ConfigError;
 
 namespace {
 
@@ -63,46 +64,56 @@ bodies:
 }
 
 TEST(Scene, ErrorsNameFileLineAndField) {
-  std::string e = sceneError("bodies:\n  - name: a\n    shapes:\n      - {type: cone, radius: 1}\n");
-  EXPECT_NE(e.find("test.yaml:4:"), std::string::npos) << e;
-  EXPECT_NE(e.find("bodies[0].shapes[0].type"), std::string::npos) << e;
-  EXPECT_NE(e.find("unknown shape type 'cone'"), std::string::npos) << e;
-
-  e = sceneError("bodies:\n  - name: a\n    shapes:\n      - type: sphere\n        radius: -0.2\n");
-  EXPECT_NE(e.find("test.yaml:5:"), std::string::npos) << e;
-  EXPECT_NE(e.find("bodies[0].shapes[0].radius"), std::string::npos) << e;
-  EXPECT_NE(e.find(">= 0"), std::string::npos) << e;
-
-  e = sceneError("bodies:\n  - name: a\n    shapes: [{type: capsule, radius: 0.1}]\n");
-  EXPECT_NE(e.find("bodies[0].shapes[0].length"), std::string::npos) << e;
-  e = sceneError("bodies:\n  - name: a\n    shapes: [{type: box, size: [1, 2]}]\n");
-  EXPECT_NE(e.find("bodies[0].shapes[0].size"), std::string::npos) << e;
-  e = sceneError("bodies:\n  - name: a\n    shapes: [{type: sphere, radius: .nan}]\n");
-  EXPECT_NE(e.find("must be finite"), std::string::npos) << e;
-  e = sceneError("bodies:\n  - name: a\n    colour: red\n    shapes: [{type: sphere, radius: 1}]\n");
-  EXPECT_NE(e.find("test.yaml:3: bodies[0].colour: unknown key"), std::string::npos) << e;
-  e = sceneError("bodies:\n  - name: a\n    shapes: [{type: sphere, radius: 1}]\n  - name: a\n    shapes: [{type: sphere, radius: 1}]\n");
-  EXPECT_NE(e.find("duplicate body 'a'"), std::string::npos) << e;
-  e = sceneError("bodies: [\n");
-  EXPECT_NE(e.find("invalid YAML"), std::string::npos) << e;
-  e = sceneError("name: x\n");
-  EXPECT_NE(e.find("bodies"), std::string::npos) << e;
+  const auto expectError = [](const std::string& yaml, const std::string& what) {
+    const std::string e = sceneError(yaml);
+    EXPECT_NE(e.find(what), std::string::npos) << "yaml:\n" << yaml << "got: " << e;
+  };
+  expectError("bodies:\n  - name: a\n    shapes:\n      - {type: cone, radius: 1}\n",
+              "test.yaml:4: field 'bodies[0].shapes[0].type': unknown shape type 'cone'");
+  expectError("bodies:\n  - name: a\n    shapes:\n      - type: sphere\n        radius: -0.2\n",
+              "test.yaml:5: field 'bodies[0].shapes[0].radius': must be > 0, got -0.2");
+  expectError("bodies:\n  - name: a\n    shapes: [{type: capsule, radius: 0.1, length: -1}]\n",
+              "test.yaml:3: field 'bodies[0].shapes[0].length': must be >= 0, got -1");
+  expectError("bodies:\n  - name: a\n    shapes: [{type: capsule, radius: 0.1}]\n",
+              "test.yaml:3: field 'bodies[0].shapes[0]': missing key 'length' (required for a capsule)");
+  expectError("bodies:\n  - name: a\n    shapes: [{radius: 0.1}]\n", "field 'bodies[0].shapes[0]': missing key 'type'");
+  expectError("bodies:\n  - name: a\n    shapes: [{type: box, size: [1, 2]}]\n",
+              "test.yaml:3: field 'bodies[0].shapes[0].size': expected [x, y, z], got 2 values");
+  expectError("bodies:\n  - name: a\n    shapes: [{type: box, size: [1, 0, 2]}]\n",
+              "field 'bodies[0].shapes[0].size[1]': must be > 0, got 0");
+  expectError("bodies:\n  - name: a\n    shapes: [{type: sphere, radius: .nan}]\n", "'.nan' is not a finite number");
+  expectError("bodies:\n  - name: a\n    shapes: [{type: plane, normal: [0, 0, 0]}]\n",
+              "field 'bodies[0].shapes[0].normal': must be non-zero");
+  expectError("bodies:\n  - name: a\n    colour: red\n    shapes: [{type: sphere, radius: 1}]\n",
+              "test.yaml:3: field 'bodies[0].colour': unknown key");
+  expectError("bodies:\n  - name: a\n    pose: {position: [0, 0, 0], yaw: 3}\n    shapes: [{type: sphere, radius: 1}]\n",
+              "test.yaml:3: field 'bodies[0].pose.yaw': unknown key (expected one of: position, rpy_deg)");
+  expectError("bodies:\n  - name: a\n    shapes: [{type: sphere, radius: 1}]\n  - name: a\n    shapes: [{type: sphere, radius: 1}]\n",
+              "test.yaml:4: field 'bodies[1].name': duplicate body 'a'");
+  expectError("bodies:\n  - name: a/b\n    shape: {type: sphere, radius: 1}\n", "field 'bodies[0].name': must be non-empty without '/'");
+  expectError("bodies:\n  - name: a\n    shape: {type: sphere, radius: 1}\n    shapes: []\n",
+              "test.yaml:2: field 'bodies[0]': give either 'shape' or 'shapes', not both");
+  expectError("bodies:\n  - name: a\n    shapes: []\n", "test.yaml:3: field 'bodies[0].shapes': expected a non-empty list of shapes");
+  expectError("bodies:\n  - name: a\n", "test.yaml:2: field 'bodies[0]': missing key 'shapes'");
+  expectError("bodies: [\n", "test.yaml:2: YAML syntax error");
+  expectError("name: x\n", "test.yaml:1: field '<top>': missing required key 'bodies'");
+  expectError("margin: -0.1\nbodies: []\n", "test.yaml:1: field 'margin': must be >= 0, got -0.1");
   try {
     loadScene("/nonexistent/scene.yaml");
-    FAIL();
+    FAIL() << "no error for a missing scene file";
   } catch (const ConfigError& err) {
-    EXPECT_NE(std::string(err.what()).find("/nonexistent/scene.yaml:0: cannot open"), std::string::npos);
+    EXPECT_EQ(std::string(err.what()).rfind("/nonexistent/scene.yaml:0: cannot read the file", 0), 0u) << err.what();
   }
 }
 
 TEST(Scene, MissingAndCorruptMeshFiles) {
   const std::string dir = test::tempDir("scene_mesh");
   std::string e = sceneError("bodies:\n  - name: a\n    shapes:\n      - {type: mesh, file: nothere.stl}\n", dir);
-  EXPECT_NE(e.find("test.yaml:4: bodies[0].shapes[0].file"), std::string::npos) << e;
+  EXPECT_NE(e.find("test.yaml:4: field 'bodies[0].shapes[0].file'"), std::string::npos) << e;
   EXPECT_NE(e.find(dir + "/nothere.stl: no such mesh file"), std::string::npos) << e;
   writeText(dir + "/garbage.stl", std::string(40, '\x01') + " this is not an STL file at all");
   e = sceneError("bodies:\n  - name: a\n    shapes:\n      - {type: mesh, file: garbage.stl}\n", dir);
-  EXPECT_NE(e.find("bodies[0].shapes[0].file"), std::string::npos) << e;
+  EXPECT_NE(e.find("field 'bodies[0].shapes[0].file'"), std::string::npos) << e;
   EXPECT_NE(e.find(dir + "/garbage.stl: "), std::string::npos) << e;
   writeText(dir + "/bad.obj", "v 0 0 0\nv 1 0 0\nf 1 2 7\n");
   e = sceneError("bodies:\n  - name: a\n    shapes:\n      - {type: mesh, file: bad.obj}\n", dir);

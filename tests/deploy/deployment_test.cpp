@@ -56,10 +56,18 @@ TEST(Deployment, ErrorsNameFileLineAndField) {
   expectError("name: x\nservices:\n  - {name: a, exec: b, publish: 'tcp://127.0.0.1:0'}\n", "ephemeral port");
   expectError("name: x\nservices:\n  - {name: a, exec: b}\n", "missing required key 'publish'");
   expectError("name: x\nservices:\n  - {name: a, exec: b, publish: 'ipc:///a', restart: {policy: sometimes}}\n",
-              "field 'services[0].restart.policy'");
+              "d.yaml:3: field 'services[0].restart.policy': expected never, on-failure or always, got 'sometimes'");
+  expectError("name: x\nrestart: {max_restarts: -1}\nservices:\n  - {name: a, exec: b, publish: 'ipc:///a'}\n",
+              "d.yaml:2: field 'restart.max_restarts': -1 is outside [0, ");
   expectError("name: x\nheartbeat_timout: 3\nservices: []\n", "d.yaml:2: field 'heartbeat_timout': unknown key");
   expectError("name: x\nservices:\n  - {name: a, exec: b, publish: 'ipc:///a', restart: {backoff_initial: -1}}\n",
               "backoff_initial");
+  try {
+    loadDeployment("/nonexistent/deployment.yaml");
+    ADD_FAILURE() << "no error for a missing deployment file";
+  } catch (const mannequin::core::ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/deployment.yaml:0: cannot read the file", 0), 0u) << e.what();
+  }
 }
 
 TEST(Deployment, ShippedDeploymentsParse) {

@@ -8,6 +8,7 @@
 #include "mannequin/skeleton/kinematics.hpp"
 
 using namespace mannequin::skeleton;
+using mannequin::core::ConfigError;
 
 namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
@@ -133,24 +134,32 @@ TEST(Anthropometry, PositiveAnglesMoveLimbsTheAnatomicalWay) {
 }
 
 TEST(Anthropometry, BadConfigsNameFileLineAndKey) {
-  EXPECT_NE(configError("sex: male\nstature_m: 1.8\nmass_kg: 80\nheight: 2\n").find("test.yaml:4: unknown key 'height'"),
-            std::string::npos);
-  EXPECT_NE(configError("sex: male\nstature_m: 18\nmass_kg: 80\n").find("test.yaml:2: 'stature_m' = 18 is outside"),
-            std::string::npos);
-  EXPECT_NE(configError("sex: male\nstature_m: 1.8\nmass_kg: heavy\n").find("test.yaml:3: 'mass_kg' must be a number"),
-            std::string::npos);
-  EXPECT_NE(configError("sex: male\nstature_m: .nan\nmass_kg: 80\n").find("finite"), std::string::npos);
-  EXPECT_NE(configError("sex: robot\nstature_m: 1.8\nmass_kg: 80\n").find("'sex' must be 'male' or 'female'"),
-            std::string::npos);
-  EXPECT_NE(configError("stature_m: 1.8\nmass_kg: 80\n").find("missing key 'sex'"), std::string::npos);
-  EXPECT_NE(configError("sex: male\nstature_m: 1.8\nmass_kg: 80\njoint_limits_deg:\n  kneee_l: [0, 90]\n")
-                .find("unknown coordinate 'kneee_l'"),
-            std::string::npos);
-  EXPECT_NE(configError("sex: male\nstature_m: 1.8\nmass_kg: 80\njoint_limits_deg:\n  knee_l: [90, 0]\n").find("min > max"),
-            std::string::npos);
-  EXPECT_NE(configError("sex: [male\n").find("invalid YAML"), std::string::npos);
-  EXPECT_NE(configError("- a\n- b\n").find("expected a mapping"), std::string::npos);
+  const auto expectError = [](const std::string& yaml, const std::string& what) {
+    const std::string e = configError(yaml);
+    EXPECT_NE(e.find(what), std::string::npos) << "yaml:\n" << yaml << "got: " << e;
+  };
+  expectError("sex: male\nstature_m: 1.8\nmass_kg: 80\nheight: 2\n", "test.yaml:4: field 'height': unknown key");
+  expectError("sex: male\nstature_m: 18\nmass_kg: 80\n", "test.yaml:2: field 'stature_m': 18 is outside [0.5, 2.5]");
+  expectError("sex: male\nstature_m: 1.8\nmass_kg: heavy\n", "test.yaml:3: field 'mass_kg': 'heavy' is not a number");
+  expectError("sex: male\nstature_m: .nan\nmass_kg: 80\n", "test.yaml:2: field 'stature_m': '.nan' is not a finite number");
+  expectError("sex: male\nstature_m: 1.8\nmass_kg: 80\ndensity_kg_m3: 5\n", "test.yaml:4: field 'density_kg_m3': 5 is outside");
+  expectError("sex: male\nstature_m: 1.8\nmass_kg: 80\ntoes: maybe\n", "test.yaml:4: field 'toes': 'maybe' is not true/false");
+  expectError("sex: robot\nstature_m: 1.8\nmass_kg: 80\n", "test.yaml:1: field 'sex': expected male or female, got 'robot'");
+  expectError("stature_m: 1.8\nmass_kg: 80\n", "test.yaml:1: field '<top>': missing required key 'sex'");
+  expectError("sex: male\nstature_m: 1.8\nmass_kg: 80\njoint_limits_deg:\n  kneee_l: [0, 90]\n",
+              "test.yaml:5: field 'joint_limits_deg.kneee_l': unknown coordinate 'kneee_l'");
+  expectError("sex: male\nstature_m: 1.8\nmass_kg: 80\njoint_limits_deg:\n  knee_l: [90, 0]\n",
+              "test.yaml:5: field 'joint_limits_deg.knee_l': [min, max] in degrees with min > max");
+  expectError("sex: male\nstature_m: 1.8\nmass_kg: 80\njoint_limits_deg:\n  knee_l: [90]\n",
+              "field 'joint_limits_deg.knee_l': expected a list of 2 numbers, got 1 values");
+  expectError("sex: [male\n", "test.yaml:2: YAML syntax error");  // yaml-cpp reports the end of input
+  expectError("- a\n- b\n", "test.yaml:1: expected a map");
   EXPECT_THROW(loadMannequinSpec("/nonexistent/mannequin.yaml"), ConfigError);
+  try {
+    loadMannequinSpec("/nonexistent/mannequin.yaml");
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/mannequin.yaml:0: cannot read the file", 0), 0u) << e.what();
+  }
   // an override is applied
   const MannequinSpec s = parseMannequinSpec("sex: female\nstature_m: 1.6\nmass_kg: 55\njoint_limits_deg:\n  knee_l: [0, 90]\n", "t");
   const Model m = buildMannequin(s);

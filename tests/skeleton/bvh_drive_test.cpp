@@ -8,6 +8,7 @@
 #include "mannequin/skeleton/kinematics.hpp"
 
 using namespace mannequin::skeleton;
+using mannequin::core::ConfigError;
 
 namespace {
 std::string repo(const std::string& rel) {
@@ -97,8 +98,22 @@ TEST(BvhDrive, BadMappingsAreReportedWithNames) {
     }
     return std::string();
   };
-  EXPECT_NE(error("name: x\nunit: furlong\nsegments:\n  pelvis: Hips\n").find("map.yaml:2: 'unit' must be"), std::string::npos);
-  EXPECT_NE(error("name: x\nsegmentz: 1\n").find("map.yaml:2: unknown key 'segmentz'"), std::string::npos);
-  EXPECT_NE(error("name: x\n").find("missing key 'segments'"), std::string::npos);
-  EXPECT_NE(error("segments:\n  pelvis: [a, b]\n").find("must name one BVH joint"), std::string::npos);
+  const auto expectError = [&](const std::string& yaml, const std::string& what) {
+    const std::string e = error(yaml);
+    EXPECT_NE(e.find(what), std::string::npos) << "yaml:\n" << yaml << "got: " << e;
+  };
+  expectError("name: x\nunit: furlong\nsegments:\n  pelvis: Hips\n",
+              "map.yaml:2: field 'unit': expected m, cm, inch or cmu, got 'furlong'");
+  expectError("name: x\nsegmentz: 1\n", "map.yaml:2: field 'segmentz': unknown key");
+  expectError("name: x\n", "map.yaml:1: field '<top>': missing required key 'segments'");
+  expectError("name: x\nsegments: {}\n", "map.yaml:2: field 'segments': expected a map of mannequin segments to BVH joints");
+  expectError("segments:\n  pelvis: [a, b]\n", "map.yaml:2: field 'segments.pelvis': must name one BVH joint");
+  expectError("unit: cm\nscale_to_m: 0.01\nsegments:\n  pelvis: Hips\n", "map.yaml:2: field 'scale_to_m': give either");
+  expectError("scale_to_m: 0\nsegments:\n  pelvis: Hips\n", "map.yaml:1: field 'scale_to_m': must be > 0");
+  try {
+    loadBvhDriveMap("/nonexistent/map.yaml");
+    ADD_FAILURE() << "no error for a missing mapping file";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()).rfind("/nonexistent/map.yaml:0: cannot read the file", 0), 0u) << e.what();
+  }
 }

@@ -1,9 +1,8 @@
 #include "mannequin/skeleton/anthropometry.hpp"
 
-#include "config_util.hpp"
-
+#include <algorithm>
 #include <cmath>
-#include <set>
+#include <stdexcept>
 
 #include "mannequin/skeleton/kinematics.hpp"
 
@@ -265,93 +264,36 @@ VectorX standingConfiguration(const Model& model) {
 
 // ---- YAML config ------------------------------------------------------------------------
 namespace {
-[[noreturn]] void configFail(const std::string& source, const YAML::Node& node, const std::string& msg) {
-  const int line = node.IsDefined() ? node.Mark().line + 1 : 0;
-  throw ConfigError(source + ":" + std::to_string(line) + ": " + msg);
-}
-
-double readNumber(const std::string& source, const YAML::Node& node, const std::string& key) {
-  try {
-    const double v = node.as<double>();
-    if (!std::isfinite(v)) configFail(source, node, "'" + key + "' must be a finite number");
-    return v;
-  } catch (const YAML::Exception&) {
-    configFail(source, node, "'" + key + "' must be a number, got '" + YAML::Dump(node) + "'");
+MannequinSpec readMannequinSpec(const core::ConfigNode& root) {
+  root.allowOnly({"name", "sex", "stature_m", "mass_kg", "toes", "density_kg_m3", "joint_limits_deg", "description",
+                  "source"});
+  MannequinSpec spec;
+  spec.name = root.get("name", spec.name);
+  spec.sex = root["sex"].choice({"male", "female"}) == 0 ? Sex::kMale : Sex::kFemale;
+  spec.stature = root["stature_m"].numIn(0.5, 2.5);
+  spec.mass = root["mass_kg"].numIn(10, 300);
+  spec.toes = root.get("toes", spec.toes);
+  spec.density = root.getIn("density_kg_m3", spec.density, 500, 2000);
+  if (const auto limits = root.find("joint_limits_deg")) {
+    // coordinate names are checked against the model built without the overrides (none read yet)
+    const auto names = buildMannequin(spec).coordinateNames();
+    for (const std::string& coord : limits->keys()) {
+      const core::ConfigNode r = (*limits)[coord];
+      if (std::find(names.begin(), names.end(), coord) == names.end())
+        r.fail("unknown coordinate '" + coord + "' (see docs/mannequin-model.md, \"Joints\")");
+      const Eigen::VectorXd lim = r.vector(2);
+      if (lim(0) > lim(1)) r.fail("[min, max] in degrees with min > max");
+      spec.limits_deg[coord] = {lim(0), lim(1)};
+    }
   }
+  return spec;
 }
 }  // namespace
 
 MannequinSpec parseMannequinSpec(const std::string& text, const std::string& source) {
-  const YAML::Node root = detail::parseYaml(text, source);
-  if (!root.IsMap()) throw ConfigError(source + ":1: expected a mapping of keys (name, sex, stature_m, mass_kg, ...)");
-
-  static const std::set<std::string> kKeys = {"name", "sex", "stature_m", "mass_kg", "toes", "density_kg_m3",
-                                              "joint_limits_deg", "description", "source"};
-  MannequinSpec spec;
-  bool has_sex = false, has_stature = false, has_mass = false;
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    const YAML::Node& v = kv.second;
-    if (!kKeys.count(key)) {
-      configFail(source, kv.first, "unknown key '" + key +
-                                       "' (expected name, sex, stature_m, mass_kg, toes, density_kg_m3, "
-                                       "joint_limits_deg, description, source)");
-    }
-    if (key == "name") {
-      spec.name = v.as<std::string>();
-    } else if (key == "sex") {
-      const std::string s = v.IsScalar() ? v.as<std::string>() : "";
-      if (s == "male") spec.sex = Sex::kMale;
-      else if (s == "female") spec.sex = Sex::kFemale;
-      else configFail(source, v, "'sex' must be 'male' or 'female', got '" + YAML::Dump(v) + "'");
-      has_sex = true;
-    } else if (key == "stature_m") {
-      spec.stature = readNumber(source, v, key);
-      if (spec.stature < 0.5 || spec.stature > 2.5)
-        configFail(source, v, "'stature_m' = " + YAML::Dump(v) + " is outside [0.5, 2.5] m");
-      has_stature = true;
-    } else if (key == "mass_kg") {
-      spec.mass = readNumber(source, v, key);
-      if (spec.mass < 10 || spec.mass > 300)
-        configFail(source, v, "'mass_kg' = " + YAML::Dump(v) + " is outside [10, 300] kg");
-      has_mass = true;
-    } else if (key == "density_kg_m3") {
-      spec.density = readNumber(source, v, key);
-      if (spec.density < 500 || spec.density > 2000)
-        configFail(source, v, "'density_kg_m3' = " + YAML::Dump(v) + " is outside [500, 2000]");
-    } else if (key == "toes") {
-      try {
-        spec.toes = v.as<bool>();
-      } catch (const YAML::Exception&) {
-        configFail(source, v, "'toes' must be true or false");
-      }
-    } else if (key == "joint_limits_deg") {
-      if (!v.IsMap()) configFail(source, v, "'joint_limits_deg' must map coordinate names to [min, max]");
-      for (const auto& lim : v) {
-        const std::string coord = lim.first.as<std::string>();
-        const YAML::Node& r = lim.second;
-        if (!r.IsSequence() || r.size() != 2)
-          configFail(source, r, "joint limit '" + coord + "' must be [min, max] in degrees");
-        const double lo = readNumber(source, r[0], coord), hi = readNumber(source, r[1], coord);
-        if (lo > hi) configFail(source, r, "joint limit '" + coord + "': min > max");
-        spec.limits_deg[coord] = {lo, hi};
-      }
-    }
-  }
-  if (!has_sex) throw ConfigError(source + ":1: missing key 'sex' (male or female)");
-  if (!has_stature) throw ConfigError(source + ":1: missing key 'stature_m'");
-  if (!has_mass) throw ConfigError(source + ":1: missing key 'mass_kg'");
-  // unknown coordinate names in overrides are reported with the file name
-  try {
-    buildMannequin(spec);
-  } catch (const std::invalid_argument& e) {
-    throw ConfigError(source + ":1: " + e.what());
-  }
-  return spec;
+  return readMannequinSpec(core::ConfigNode::parse(text, source));
 }
 
-MannequinSpec loadMannequinSpec(const std::string& path) {
-  return parseMannequinSpec(detail::readConfigFile(path, "mannequin config"), path);
-}
+MannequinSpec loadMannequinSpec(const std::string& path) { return readMannequinSpec(core::ConfigNode::load(path)); }
 
 }  // namespace mannequin::skeleton

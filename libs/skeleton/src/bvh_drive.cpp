@@ -1,10 +1,9 @@
 #include "mannequin/skeleton/bvh_drive.hpp"
 
-#include "config_util.hpp"
-
 #include <cmath>
 
-#include "mannequin/skeleton/anthropometry.hpp"
+#include "mannequin/core/config.hpp"
+#include "mannequin/skeleton/anthropometry.hpp"  // standingConfiguration
 #include "mannequin/skeleton/kinematics.hpp"
 
 namespace mannequin::skeleton {
@@ -43,51 +42,35 @@ std::vector<int> chainOf(const Model& m, int segment, const std::vector<char>& c
 }  // namespace
 
 // ---- mapping config -----------------------------------------------------------------------
-BvhDriveMap parseBvhDriveMap(const std::string& text, const std::string& source) {
-  const auto fail = [&](const YAML::Node& n, const std::string& msg) -> void {
-    throw ConfigError(source + ":" + std::to_string(n.IsDefined() ? n.Mark().line + 1 : 1) + ": " + msg);
-  };
-  const YAML::Node root = detail::parseYaml(text, source);
-  if (!root.IsMap()) throw ConfigError(source + ":1: expected a mapping with keys name, unit, segments");
+namespace {
+BvhDriveMap readBvhDriveMap(const core::ConfigNode& root) {
+  root.allowOnly({"name", "unit", "scale_to_m", "segments"});
   BvhDriveMap map;
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    const YAML::Node& v = kv.second;
-    if (key == "name") {
-      map.name = v.as<std::string>();
-    } else if (key == "unit") {
-      const std::string u = v.IsScalar() ? v.as<std::string>() : "";
-      if (u == "m") map.unit_scale_to_m = bvhUnitScale(BvhUnit::Metre);
-      else if (u == "cm") map.unit_scale_to_m = bvhUnitScale(BvhUnit::Centimetre);
-      else if (u == "inch") map.unit_scale_to_m = bvhUnitScale(BvhUnit::Inch);
-      else if (u == "cmu") map.unit_scale_to_m = bvhUnitScale(BvhUnit::Cmu);
-      else fail(v, "'unit' must be m, cm, inch or cmu, got '" + YAML::Dump(v) + "'");
-    } else if (key == "scale_to_m") {
-      double s = 0;
-      try {
-        s = v.as<double>();
-      } catch (const YAML::Exception&) {
-        fail(v, "'scale_to_m' must be a number");
-      }
-      if (!std::isfinite(s) || s <= 0) fail(v, "'scale_to_m' must be finite and > 0");
-      map.unit_scale_to_m = s;
-    } else if (key == "segments") {
-      if (!v.IsMap() || v.size() == 0) fail(v, "'segments' must map mannequin segments to BVH joints");
-      for (const auto& s : v) {
-        if (!s.second.IsScalar()) fail(s.second, "segment '" + s.first.as<std::string>() + "' must name one BVH joint");
-        map.segments.emplace_back(s.first.as<std::string>(), s.second.as<std::string>());
-      }
-    } else {
-      fail(kv.first, "unknown key '" + key + "' (expected name, unit, scale_to_m, segments)");
-    }
+  map.name = root.get("name", map.name);
+  const auto unit = root.find("unit");
+  const auto scale = root.find("scale_to_m");
+  if (unit && scale) scale->fail("give either 'unit' or 'scale_to_m', not both");
+  if (unit) {
+    static const BvhUnit kUnits[] = {BvhUnit::Metre, BvhUnit::Centimetre, BvhUnit::Inch, BvhUnit::Cmu};
+    map.unit_scale_to_m = bvhUnitScale(kUnits[unit->choice({"m", "cm", "inch", "cmu"})]);
   }
-  if (map.segments.empty()) throw ConfigError(source + ":1: missing key 'segments'");
+  if (scale) map.unit_scale_to_m = scale->positive();
+  const core::ConfigNode segments = root["segments"];
+  for (const std::string& segment : segments.keys()) {
+    const core::ConfigNode joint = segments[segment];
+    if (!joint.isScalar()) joint.fail("must name one BVH joint");
+    map.segments.emplace_back(segment, joint.str());
+  }
+  if (map.segments.empty()) segments.fail("expected a map of mannequin segments to BVH joints, got none");
   return map;
 }
+}  // namespace
 
-BvhDriveMap loadBvhDriveMap(const std::string& path) {
-  return parseBvhDriveMap(detail::readConfigFile(path, "mapping config"), path);
+BvhDriveMap parseBvhDriveMap(const std::string& text, const std::string& source) {
+  return readBvhDriveMap(core::ConfigNode::parse(text, source));
 }
+
+BvhDriveMap loadBvhDriveMap(const std::string& path) { return readBvhDriveMap(core::ConfigNode::load(path)); }
 
 // ---- calibration --------------------------------------------------------------------------
 BvhDriver::BvhDriver(const Model& model, const Bvh& bvh, const BvhDriveMap& map)

@@ -14,15 +14,7 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
   c.name = root.get("name", c.name);
   if (auto p = root.find("publish")) c.publish = p->strings();
   if (auto p = root.find("connect")) c.connect = p->strings();
-  if (auto m = root.find("mode")) {
-    const std::string v = m->str();
-    if (v == "live")
-      c.mode = Mode::kLive;
-    else if (v == "replay")
-      c.mode = Mode::kReplay;
-    else
-      m->fail("expected live or replay");
-  }
+  if (auto m = root.find("mode")) c.mode = m->choice({"live", "replay"}) == 0 ? Mode::kLive : Mode::kReplay;
   c.world.step = root.getIn("step", 0.001, 1e-5, 0.1);
   c.world_rate = root.getIn("world_rate", 60.0, 0.1, 1.0 / c.world.step);
   c.publish_on_mocap = root.get("publish_on_mocap", false);
@@ -40,15 +32,8 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
     c.world.calibration_fit_steps = o->get("fit_steps", c.world.calibration_fit_steps);
     if (c.world.calibration_fit_steps < 0) (*o)["fit_steps"].fail("must be >= 0");
   }
-  if (auto st = root.find("stepper")) {
-    const std::string v = st->str();
-    if (v == "controller")
-      c.stepper = StepperKind::kController;
-    else if (v == "kinematic")
-      c.stepper = StepperKind::kKinematic;
-    else
-      st->fail("expected controller or kinematic");
-  }
+  if (auto st = root.find("stepper"))
+    c.stepper = st->choice({"controller", "kinematic"}) == 0 ? StepperKind::kController : StepperKind::kKinematic;
   if (auto tt = root.find("target_twist")) {
     tt->allowOnly({"enabled", "max_speed"});
     c.world.target_twist = tt->get("enabled", c.world.target_twist);
@@ -91,6 +76,8 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
   for (const ConfigNode& m : root["mannequins"].items()) {
     m.allowOnly({"name", "config", "root_frame", "control_frames", "controller"});
     MannequinEntry e;
+    e.where = m.where();
+    e.field = m.path();
     e.name = m["name"].str();
     e.config = m["config"].str();
     e.root_frame = m.get("root_frame", e.root_frame);
@@ -109,22 +96,31 @@ SimServiceConfig loadSimConfig(const std::string& path) { return parseSimConfig(
 std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config) {
   std::vector<sim::MannequinSetup> out;
   for (const MannequinEntry& e : config.mannequins) {
+    // errors name the sim config's entry, then the mannequin and what failed (the file's own FILE:LINE)
+    const auto fail = [&](const std::string& what) {
+      if (e.where.empty()) throw core::ConfigError("mannequin '" + e.name + "': " + what);
+      core::failAt(e.where, e.field, "mannequin '" + e.name + "': " + what);
+    };
     sim::MannequinSetup s;
     s.name = e.name;
-    s.model = skeleton::buildMannequin(skeleton::loadMannequinSpec(e.config));
+    try {
+      s.model = skeleton::buildMannequin(skeleton::loadMannequinSpec(e.config));
+    } catch (const std::exception& ex) {
+      fail(std::string("config: ") + ex.what());
+    }
     s.frames = e.frames;
     s.root_frame = e.root_frame;
     for (const auto& f : e.frames)
       if (s.model.findFrame(f.frame) < 0) {
         std::string list;
         for (const auto& fr : s.model.frames) list += (list.empty() ? "" : ", ") + fr.name;
-        throw core::ConfigError("mannequin '" + e.name + "': no frame '" + f.frame + "' in " + e.config + " (frames: " + list + ")");
+        fail("control_frames: no frame '" + f.frame + "' in " + e.config + " (frames: " + list + ")");
       }
     if (config.stepper == StepperKind::kController) {
       try {
         s.controller = control::loadControllerConfig(e.controller);
       } catch (const std::exception& ex) {
-        throw core::ConfigError("mannequin '" + e.name + "': controller: " + ex.what());
+        fail(std::string("controller: ") + ex.what());
       }
     }
     out.push_back(std::move(s));

@@ -27,13 +27,12 @@
 #include <vector>
 
 #include "mannequin/collision/shape.hpp"
+#include "mannequin/core/config.hpp"  // ConfigError
 #include "mannequin/math/se3.hpp"
-#include "mannequin/skeleton/anthropometry.hpp"  // ConfigError
 
 namespace mannequin::collision {
 
 using math::SE3;
-using skeleton::ConfigError;
 
 /// A shape placed in its body.
 struct PlacedShape {
@@ -59,12 +58,12 @@ struct SceneSpec {
 };
 
 /// Parses scene YAML; `source` names it in errors and `base_dir` resolves relative mesh paths.
-/// \throws ConfigError "SOURCE:LINE: FIELD: message" (unknown shape type, negative radius, missing
-/// or corrupt mesh file with the mesh's own message, duplicate body name, unknown key...).
+/// \throws core::ConfigError "SOURCE:LINE: field 'a.b': message" (unknown shape type, negative radius,
+/// missing or corrupt mesh file with the mesh's own message, duplicate body name, unknown key...).
 SceneSpec parseScene(const std::string& yaml_text, const std::string& source,
                      const std::string& base_dir = ".");
 
-/// Reads and parses a scene file. \throws ConfigError (unreadable file included).
+/// Reads and parses a scene file. \throws core::ConfigError (unreadable file included, line 0).
 SceneSpec loadScene(const std::string& path);
 
 /// Roll-pitch-yaw (rad) to a rotation: Rz(yaw) Ry(pitch) Rx(roll).

@@ -13,11 +13,9 @@
 #include "mannequin/control/energy.hpp"
 #include "mannequin/control/projector.hpp"
 #include "mannequin/control/virtual_mechanism.hpp"
-#include "mannequin/skeleton/anthropometry.hpp"  // ConfigError
+#include "mannequin/core/config.hpp"
 
 namespace mannequin::control {
-
-using skeleton::ConfigError;
 
 /// A virtual mechanism attached to a control frame, with the coupling to its effector.
 struct MechanismConfig {
@@ -75,14 +73,16 @@ struct ControllerConfig {
 };
 
 /// Parses YAML text; `source` names it in errors. Checks everything that does not need the model
-/// (the Controller checks names against the model).
-/// \throws ConfigError "SOURCE:LINE: field: message".
+/// (the Controller checks names against the model); unknown keys are refused.
+/// \throws core::ConfigError "SOURCE:LINE: field 'a.b': message".
 ControllerConfig parseControllerConfig(const std::string& yaml_text, const std::string& source);
-/// Reads and parses a file. \throws ConfigError (unreadable file included, line 0).
+/// Reads and parses a file. \throws core::ConfigError (unreadable file included, line 0).
 ControllerConfig loadControllerConfig(const std::string& path);
 
 /// Parses one mechanism block (the `mechanism:` map of a control frame; also used by scenario
-/// files). \throws ConfigError "SOURCE:LINE: field: message".
+/// files). \throws core::ConfigError "SOURCE:LINE: field 'a.b': message".
 MechanismConfig parseMechanismConfig(const std::string& yaml_text, const std::string& source);
+/// The same for a block inside another file (errors name that file, its lines and the block's path).
+MechanismConfig parseMechanismConfig(const core::ConfigNode& node);
 
 }  // namespace mannequin::control

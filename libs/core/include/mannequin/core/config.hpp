@@ -10,6 +10,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 namespace mannequin::core {
 
@@ -44,10 +45,20 @@ class ConfigNode {
   bool isScalar() const { return node_.IsScalar(); }
 
   std::string str() const;
-  double num() const;            ///< finite number
+  double num() const;            ///< finite number (YAML's .inf and .nan are refused)
+  double positive() const;       ///< finite number > 0
+  double nonNegative() const;    ///< finite number >= 0
+  double numIn(double lo, double hi) const;  ///< finite number in [lo, hi]
+  double numOrInfinity() const;  ///< a number or ±.inf (e.g. a free end stop); NaN refused
   long long integer() const;
+  long long integerIn(long long lo, long long hi) const;
   bool boolean() const;
   Eigen::Vector3d vec3() const;    ///< [x, y, z]
+  Eigen::VectorXd vector(int size = -1) const;  ///< a list of finite numbers, of `size` numbers if >= 0
+  /// [roll, pitch, yaw] in degrees → R = Rz(yaw) Ry(pitch) Rx(roll).
+  Eigen::Matrix3d rpyDeg() const;
+  /// Index of the value in `options`. \throws ConfigError "expected a, b or c, got 'x'".
+  std::size_t choice(const std::vector<std::string>& options) const;
   std::vector<std::string> strings() const;  ///< a scalar or a sequence of scalars
 
   /// Value of `key` or `fallback` when absent.
@@ -66,11 +77,17 @@ class ConfigNode {
   const std::string& file() const { return file_; }
   const std::string& path() const { return path_; }
   int line() const;
+  /// "FILE:LINE", to name this entry in errors found after reading (see failAt).
+  std::string where() const;
 
  private:
   YAML::Node node_;
   std::string file_;
   std::string path_;
 };
+
+/// \throws ConfigError "WHERE: field 'FIELD': MESSAGE" for a problem found after reading (a frame the
+/// model lacks...); `where` is a ConfigNode::where() kept with the value.
+[[noreturn]] void failAt(const std::string& where, const std::string& field, const std::string& message);
 
 }  // namespace mannequin::core

@@ -17,10 +17,10 @@
 /// Segment names: pelvis, abdomen, thorax, head, clavicle_{l,r}, upper_arm_{l,r}, forearm_{l,r},
 /// hand_{l,r}, thigh_{l,r}, shank_{l,r}, foot_{l,r} (and toes_{l,r} when enabled).
 #include <map>
-#include <stdexcept>
 #include <string>
 #include <utility>
 
+#include "mannequin/core/config.hpp"  // ConfigError
 #include "mannequin/skeleton/model.hpp"
 
 namespace mannequin::skeleton {
@@ -39,21 +39,16 @@ struct MannequinSpec {
   std::map<std::string, std::pair<double, double>> limits_deg;
 };
 
-/// An error in a config file: the message starts with "FILE:LINE: ".
-class ConfigError : public std::runtime_error {
- public:
-  using std::runtime_error::runtime_error;
-};
-
 /// Builds the model. \throws std::invalid_argument for a stature outside [0.5, 2.5] m, a mass
 /// outside [10, 300] kg, a non-finite value, or a limit override naming an unknown coordinate.
 Model buildMannequin(const MannequinSpec& spec);
 
 /// Parses a mannequin config from YAML text; `source` names it in errors.
-/// \throws ConfigError naming source, line and the offending key or value.
+/// \throws core::ConfigError "SOURCE:LINE: field 'key': message" (unknown key, value out of range, a limit
+/// override naming no coordinate).
 MannequinSpec parseMannequinSpec(const std::string& yaml_text, const std::string& source);
 
-/// Reads and parses a config file. \throws ConfigError (unreadable file included).
+/// Reads and parses a config file. \throws core::ConfigError (unreadable file included, line 0).
 MannequinSpec loadMannequinSpec(const std::string& path);
 
 /// Configuration standing on the floor z = 0: the neutral posture with the pelvis raised so the

@@ -29,8 +29,10 @@ struct BvhDriveMap {
   std::vector<std::pair<std::string, std::string>> segments;
 };
 
-/// Parses a mapping config (keys: name, unit or scale_to_m, segments). \throws ConfigError "FILE:LINE: ...".
+/// Parses a mapping config (keys: name, unit or scale_to_m, segments).
+/// \throws core::ConfigError "FILE:LINE: field 'key': message" (unknown key, unknown unit, no segments...).
 BvhDriveMap parseBvhDriveMap(const std::string& yaml_text, const std::string& source);
+/// Reads and parses a mapping file. \throws core::ConfigError (unreadable file included, line 0).
 BvhDriveMap loadBvhDriveMap(const std::string& path);
 
 /// Per-frame result of the transfer.

@@ -26,6 +26,8 @@ struct MannequinEntry {
   std::string root_frame = "pelvis";
   std::vector<sim::ControlFrameSpec> frames;
   std::string controller = "configs/control/mocap.yaml";  ///< stepper: controller
+  std::string where;         ///< "FILE:LINE" of its entry in the sim config ("" if not read from a file)
+  std::string field;         ///< its path there ("mannequins[0]"), for errors found by buildMannequins
 };
 
 /// What steps the mannequins: the control library's Controller (default) or the KinematicTracker.
@@ -48,7 +50,9 @@ struct SimServiceConfig {
 SimServiceConfig parseSimConfig(const core::ConfigNode& root);
 SimServiceConfig loadSimConfig(const std::string& path);
 
-/// Builds the World's mannequins (loads every mannequin config). \throws core::ConfigError.
+/// Builds the World's mannequins (loads every mannequin config).
+/// \throws core::ConfigError "FILE:LINE: field 'mannequins[i]': mannequin 'a': ..." naming the entry, then
+/// the failure (a mannequin or controller config's own FILE:LINE error, a control frame the model lacks).
 std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config);
 
 }  // namespace mannequin::simservice
