@@ -45,14 +45,14 @@ void worldStep(benchmark::State& state, bool controller, bool feed_forward) {
   World w(std::move(setups), cfg);
   auto frameAt = [&](std::int64_t stamp_ns) {
     const double t = static_cast<double>(stamp_ns) * 1e-9, a = 2 * M_PI * t;
-    MocapInput f;
+    mocap::Frame f;
     f.stamp_ns = stamp_ns;
     for (int i = 0; i < 6; ++i) {
       math::SE3 H = rest[i];
       if (i == 0) H.p += math::Vector3(0.03 * std::sin(a / 2), 0.03 * std::sin(a / 3), 0);
       if (i == 2) H.p += math::Vector3(0.2 * std::sin(a), 0, 0.2 * (1 - std::cos(a)));
       if (i == 3) H.p += math::Vector3(0.2 * (1 - std::cos(a)), 0, 0.2 * std::sin(a));
-      f.bodies.push_back({kBodies[i], H, true});
+      f.bodies.push_back({kBodies[i], i, H, true});
     }
     return f;
   };

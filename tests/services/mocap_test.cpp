@@ -32,7 +32,7 @@ core::ConfigNode configOf(const std::string& text) { return core::ConfigNode::pa
 }  // namespace
 
 TEST(DTrack2, ParsesARealDatagram) {
-  DTrackFrame f;
+  DTrackDatagram f;
   ASSERT_EQ(parseDTrack(kRealDatagram, f), "");
   EXPECT_EQ(f.frame_counter.value(), 518169u);
   EXPECT_DOUBLE_EQ(f.timestamp.value(), 30331.359222);
@@ -49,7 +49,7 @@ TEST(DTrack2, ParsesARealDatagram) {
 }
 
 TEST(DTrack2, AcceptsLfLinesThreeValuePositionsAndSkipsOtherRecords) {
-  DTrackFrame f;
+  DTrackDatagram f;
   const std::string d =
       "fr 7\n6df2 1 1 [0 1.000 2 2][1 2 3][1 0 0 0 1 0 0 0 1][0 0.0 0.0]\n"
       "6d 2 [0 0.5][100 200 300][1 0 0 0 1 0 0 0 1] [3 -1.000][0 0 0][1 0 0 0 1 0 0 0 1]\n3d 0\n";
@@ -80,7 +80,7 @@ TEST(DTrack2, RejectsMalformedDatagramsNamingTheLine) {
       {std::string("fr 1\n6d 0\x01\n"), "control character"},
   };
   for (const auto& c : cases) {
-    DTrackFrame f;
+    DTrackDatagram f;
     const std::string why = parseDTrack(c.text, f);
     EXPECT_NE(why.find(c.expect), std::string::npos) << "datagram: " << c.text << "\nerror: " << why;
   }
