@@ -52,7 +52,7 @@ void worldStep(benchmark::State& state, bool controller, bool feed_forward) {
       if (i == 0) H.p += math::Vector3(0.03 * std::sin(a / 2), 0.03 * std::sin(a / 3), 0);
       if (i == 2) H.p += math::Vector3(0.2 * std::sin(a), 0, 0.2 * (1 - std::cos(a)));
       if (i == 3) H.p += math::Vector3(0.2 * (1 - std::cos(a)), 0, 0.2 * std::sin(a));
-      f.bodies.push_back({kBodies[i], i, H, true});
+      f.bodies.push_back({kBodies[i], H, true});
     }
     return f;
   };

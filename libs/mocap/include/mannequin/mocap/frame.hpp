@@ -14,10 +14,10 @@ namespace mannequin::mocap {
 /// One rigid body of a frame.
 struct Body {
   std::string name;
-  int id = -1;          ///< source id (DTrack id, BVH joint index)
   math::SE3 pose;       ///< body frame in the room frame (z up, m)
   bool tracked = true;  ///< false: occluded in this frame (pose = last tracked pose, or identity if never seen)
   double quality = 1.0; ///< [0, 1]
+  int id = -1;          ///< source id (DTrack id, BVH joint index)
 };
 
 /// One frame of a source.
