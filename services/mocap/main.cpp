@@ -11,21 +11,20 @@
 using namespace mannequin;
 
 int main(int argc, char** argv) {
-  CLI::App app{"mannequin-mocap: motion-capture service. Reads a source (BVH file, synthetic trajectories,\n"
-               "ART DTrack2 UDP ASCII) and publishes mocap.frame (rigid bodies in the room frame, capture\n"
-               "timestamps) and health.heartbeat."};
-  service::CommonOptions common;
-  service::addCommonOptions(app, common);
+  service::Cli cli{"mannequin-mocap: motion-capture service. Reads a source (BVH file, synthetic trajectories,\n"
+                   "ART DTrack2 UDP ASCII) and publishes mocap.frame (rigid bodies in the room frame, capture\n"
+                   "timestamps) and health.heartbeat."};
+  service::CommonOptions& common = cli.options;
   std::string source_kind, bvh;
   double rate = 0;
   bool loop = false, no_loop = false, exit_at_end = false;
-  app.add_option("--source", source_kind, "override the config's source (bvh, synthetic, dtrack2)");
-  app.add_option("--bvh", bvh, "override bvh.file")->check(CLI::ExistingFile);
-  app.add_option("--rate", rate, "override bvh.rate (playback rate factor)")->check(CLI::PositiveNumber);
-  app.add_flag("--loop", loop, "loop the BVH file");
-  app.add_flag("--no-loop", no_loop, "play the BVH file once");
-  app.add_flag("--exit-at-end", exit_at_end, "exit when a file source ends (default: keep heartbeating, state FINISHED)");
-  return service::runService(app, common, argc, argv, [&](const std::atomic<bool>& stop) {
+  cli.app.add_option("--source", source_kind, "override the config's source (bvh, synthetic, dtrack2)");
+  cli.app.add_option("--bvh", bvh, "override bvh.file")->check(CLI::ExistingFile);
+  cli.app.add_option("--rate", rate, "override bvh.rate (playback rate factor)")->check(CLI::PositiveNumber);
+  cli.app.add_flag("--loop", loop, "loop the BVH file");
+  cli.app.add_flag("--no-loop", no_loop, "play the BVH file once");
+  cli.app.add_flag("--exit-at-end", exit_at_end, "exit when a file source ends (default: keep heartbeating, state FINISHED)");
+  return cli.run(argc, argv, [&](const std::atomic<bool>& stop) {
     const core::ConfigNode config = service::loadConfig(common, [&](YAML::Node& raw) {
       if (!source_kind.empty()) raw["source"] = source_kind;
       if (!bvh.empty()) raw["bvh"]["file"] = bvh;

@@ -5,16 +5,15 @@
 using namespace mannequin;
 
 int main(int argc, char** argv) {
-  CLI::App app{"mannequin-sim: steps the mannequins (calibrated mocap bodies → control frames, fixed step)\n"
-               "from mocap.frame, publishes sim.world, lockstep with mannequin-collision. Live mode is paced\n"
-               "by the wall clock; replay mode by the input timestamps (deterministic)."};
-  service::CommonOptions common;
-  service::addCommonOptions(app, common);
+  service::Cli cli{"mannequin-sim: steps the mannequins (calibrated mocap bodies → control frames, fixed step)\n"
+                   "from mocap.frame, publishes sim.world, lockstep with mannequin-collision. Live mode is paced\n"
+                   "by the wall clock; replay mode by the input timestamps (deterministic)."};
+  service::CommonOptions& common = cli.options;
   std::string mode;
   double world_rate = 0;
-  app.add_option("--mode", mode, "override the config's mode (live, replay)")->check(CLI::IsMember({"live", "replay"}));
-  app.add_option("--world-rate", world_rate, "override world_rate (Hz)")->check(CLI::PositiveNumber);
-  return service::runService(app, common, argc, argv, [&](const std::atomic<bool>& stop) {
+  cli.app.add_option("--mode", mode, "override the config's mode (live, replay)")->check(CLI::IsMember({"live", "replay"}));
+  cli.app.add_option("--world-rate", world_rate, "override world_rate (Hz)")->check(CLI::PositiveNumber);
+  return cli.run(argc, argv, [&](const std::atomic<bool>& stop) {
     const core::ConfigNode node = service::loadConfig(common, [&](YAML::Node& raw) {
       if (!mode.empty()) raw["mode"] = mode;
       if (world_rate > 0) raw["world_rate"] = world_rate;

@@ -217,6 +217,24 @@ TEST(Synthetic, HandCheckablePositionsAndOcclusion) {
   EXPECT_TRUE(src.finished());
 }
 
+TEST(MocapConfig, ShippedFilesAreFoundFromAnotherWorkingDirectory) {
+  const std::filesystem::path old = std::filesystem::current_path();
+  std::filesystem::current_path(std::filesystem::temp_directory_path());
+  std::unique_ptr<Source> bvh;
+  std::string error;
+  try {
+    bvh = makeSource(configOf(
+        "source: bvh\nbvh:\n  file: data/bvh/cmu_max_131_03.bvh\n  map: configs/mappings/cmu.yaml\n  bodies: [pelvis]\n"));
+    makeSource(configOf("source: bvh\nbvh:\n  file: data/bvh/nothing_here.bvh\n  bodies: {pelvis: Hips}\n"));
+  } catch (const core::ConfigError& e) {
+    error = e.what();
+  }
+  std::filesystem::current_path(old);
+  ASSERT_NE(bvh, nullptr) << error;
+  EXPECT_EQ(bvh->kind(), "bvh");
+  EXPECT_NE(error.find("test.yaml:3: field 'bvh.file': data/bvh/nothing_here.bvh: not found"), std::string::npos) << error;
+}
+
 TEST(MocapConfig, BuildsSourcesAndNamesFileLineAndField) {
   auto bvh = makeSource(configOf(
       "source: bvh\nbvh:\n  file: data/bvh/cmu_max_131_03.bvh\n  map: configs/mappings/cmu.yaml\n  bodies: [pelvis, head]\n"));

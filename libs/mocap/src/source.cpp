@@ -3,6 +3,7 @@
 #include <cmath>
 #include <thread>
 
+#include "mannequin/core/paths.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/mocap/bvh_source.hpp"
 #include "mannequin/mocap/dtrack2.hpp"
@@ -32,12 +33,16 @@ std::unique_ptr<Source> makeBvh(const ConfigNode& c) {
   c.allowOnly({"file", "map", "unit_scale_to_m", "bodies", "rate", "loop", "start_frame", "end_frame", "paced",
                "mark_calibration"});
   BvhSourceOptions o;
-  o.file = c["file"].str();
+  try {
+    o.file = core::findData(c["file"].str());
+  } catch (const core::ConfigError& e) {
+    c["file"].fail(e.what());
+  }
   skeleton::BvhDriveMap map;
   const auto map_node = c.find("map");
   if (map_node) {
     try {
-      map = skeleton::loadBvhDriveMap(map_node->str());
+      map = skeleton::loadBvhDriveMap(core::findData(map_node->str()));
     } catch (const std::exception& e) {
       map_node->fail(e.what());
     }

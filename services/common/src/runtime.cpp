@@ -19,10 +19,11 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
       ->check(CLI::Range(0.01, 60.0));
 }
 
-int runService(CLI::App& app, CommonOptions& o, int argc, char** argv,
-               const std::function<int(const std::atomic<bool>& stop)>& body) {
+Cli::Cli(std::string description) : app(std::move(description)) { addCommonOptions(app, options); }
+
+int Cli::run(int argc, char** argv, const std::function<int(const std::atomic<bool>& stop)>& body) {
   return core::runMain(app, argc, argv, [&] {
-    core::setupLogging(o.log_level);
+    core::setupLogging(options.log_level);
     return body(core::installStopSignals());
   });
 }

@@ -30,10 +30,15 @@ struct CommonOptions {
 /// Adds the common options to a CLI11 app (--config is required).
 void addCommonOptions(CLI::App& app, CommonOptions& options);
 
-/// core::runMain for a service: parses, sets the --log-level, installs the stop signals, then runs
-/// body(stop). Exit codes as core::runMain (0, 1 when the body throws, 2 on a bad command line).
-int runService(CLI::App& app, CommonOptions& options, int argc, char** argv,
-               const std::function<int(const std::atomic<bool>& stop)>& body);
+/// A service's command line: the CLI11 app with the common options (add the service's own to `app`).
+struct Cli {
+  explicit Cli(std::string description);
+  CLI::App app;
+  CommonOptions options;
+  /// core::runMain for a service: parses, sets the --log-level, installs the stop signals, then runs
+  /// body(stop). Exit codes as core::runMain (0, 1 when the body throws, 2 on a bad command line).
+  int run(int argc, char** argv, const std::function<int(const std::atomic<bool>& stop)>& body);
+};
 
 /// Loads --config (FILE:LINE on syntax errors) and applies the command-line overrides to the tree.
 /// \throws core::ConfigError.
