@@ -1,5 +1,4 @@
 // mannequin-launch: runs every service of a deployment file on this host (see docs/cluster.md).
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
@@ -7,9 +6,9 @@
 #include <fstream>
 #include <iostream>
 
+#include "mannequin/core/main.hpp"
 #include "mannequin/deploy/supervisor.hpp"
 #include "mannequin/core/config.hpp"
-#include "mannequin/service/runtime.hpp"
 
 using namespace mannequin;
 
@@ -33,14 +32,7 @@ int main(int argc, char** argv) {
   app.add_flag("--no-tty", no_tty, "print status lines instead of one live line even on a terminal");
   app.add_option("--summary-json", summary_json, "also write the final summary as JSON to this file");
   app.add_flag("--check", check, "read the deployment, print the command lines, start nothing");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
-  try {
-    service::setupLogging("info");
+  return core::runMain(app, argc, argv, [&] {
     const deploy::Deployment d = deploy::loadDeployment(file, run_dir);
     deploy::SupervisorOptions o;
     o.exec_dir = std::filesystem::canonical("/proc/self/exe").parent_path().string();
@@ -59,7 +51,7 @@ int main(int argc, char** argv) {
       }
       return 0;
     }
-    const auto& stop = service::installStopSignals();
+    const auto& stop = core::installStopSignals();
     const int rc = supervisor.run(stop);
     std::cout << supervisor.summary() << std::flush;
     if (!summary_json.empty()) {
@@ -68,8 +60,5 @@ int main(int argc, char** argv) {
       if (!out) throw std::runtime_error(summary_json + ": cannot write");
     }
     return rc;
-  } catch (const std::exception& e) {
-    spdlog::critical("{}", e.what());
-    return 1;
-  }
+  });
 }

@@ -33,7 +33,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     const math::SE3 H = transport::fromMsg(pose);
     if (!H.R.allFinite() || !H.p.allFinite()) __builtin_trap();
   }
-  mocap::DTrackFrame frame;
+  mocap::DTrackDatagram frame;
   if (mocap::parseDTrack(std::string_view(reinterpret_cast<const char*>(data), size), frame).empty())
     for (const auto& b : frame.bodies)
       if (!b.position_mm.allFinite() || !b.rotation.allFinite()) __builtin_trap();

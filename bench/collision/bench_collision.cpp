@@ -1,4 +1,4 @@
-// bench-collision: World::query per step in (a) one mannequin on a floor, (b) two mannequins
+// bench-collision: CollisionWorld::query per step in (a) one mannequin on a floor, (b) two mannequins
 // around a table, (c) one seated mannequin in the 14k-triangle cockpit, (d) a stress case with
 // ~280 contacts; plus raw FCL references (broadphase vs a box floor, per-capsule distance to
 // the panel mesh: the trap). Run from the repository root (scenes are read from configs/).
@@ -69,7 +69,7 @@ math::VectorX armsForward(math::VectorX q, double flexion, double elbow) {
   return q;
 }
 
-void runQueries(benchmark::State& state, World& w, const std::vector<std::pair<int, const Motion*>>& people) {
+void runQueries(benchmark::State& state, CollisionWorld& w, const std::vector<std::pair<int, const Motion*>>& people) {
   ContactSet cs;
   cs.contacts.reserve(1024);
   std::int64_t step = 0;
@@ -95,7 +95,7 @@ void runQueries(benchmark::State& state, World& w, const std::vector<std::pair<i
 
 // (a) one mannequin standing on the floor
 void BM_QueryA_MannequinOnFloor(benchmark::State& state) {
-  World w;
+  CollisionWorld w;
   w.addScene(loadScene(path("configs/scenes/floor.yaml")));
   const int m = w.addMannequin(model());
   Motion motion(skeleton::standingConfiguration(model()));
@@ -105,7 +105,7 @@ BENCHMARK(BM_QueryA_MannequinOnFloor);
 
 // (b) two mannequins on either side of the table, hands forward over it
 void BM_QueryB_TwoMannequinsAroundTable(benchmark::State& state) {
-  World w;
+  CollisionWorld w;
   w.addScene(loadScene(path("configs/scenes/table.yaml")));
   const int a = w.addMannequin(model());
   const int b = w.addMannequin(model());
@@ -137,7 +137,7 @@ math::VectorX seated() {
 }
 
 // slides the seated mannequin along x until its hands are 5 mm from the panel
-math::VectorX seatedInCockpit(World& w, int m) {
+math::VectorX seatedInCockpit(CollisionWorld& w, int m) {
   math::VectorX q = seated();
   skeleton::Data d(model());
   const int panel = w.findBody("scene/panel");
@@ -160,7 +160,7 @@ math::VectorX seatedInCockpit(World& w, int m) {
 // the pose of (c), for the raw-FCL references
 const math::VectorX& cockpitPose() {
   static const math::VectorX q = [] {
-    World w;
+    CollisionWorld w;
     w.addScene(loadScene(path("configs/scenes/cockpit.yaml")));
     return seatedInCockpit(w, w.addMannequin(model()));
   }();
@@ -168,7 +168,7 @@ const math::VectorX& cockpitPose() {
 }
 
 void BM_QueryC_SeatedInCockpit(benchmark::State& state) {
-  World w;
+  CollisionWorld w;
   w.addScene(loadScene(path("configs/scenes/cockpit.yaml")));
   const int m = w.addMannequin(model());
   Motion motion(seatedInCockpit(w, m));
@@ -178,7 +178,7 @@ BENCHMARK(BM_QueryC_SeatedInCockpit);
 
 // (d) stress: a mannequin lying on the floor and 60 boxes resting on the table (~280 contacts)
 void BM_QueryD_Stress280(benchmark::State& state) {
-  World w;
+  CollisionWorld w;
   w.addScene(loadScene(path("configs/scenes/table.yaml")));
   for (int i = 0; i < 10; ++i)
     for (int j = 0; j < 6; ++j)

@@ -45,7 +45,7 @@ void worldStep(benchmark::State& state, bool controller, bool feed_forward) {
   World w(std::move(setups), cfg);
   auto frameAt = [&](std::int64_t stamp_ns) {
     const double t = static_cast<double>(stamp_ns) * 1e-9, a = 2 * M_PI * t;
-    MocapInput f;
+    mocap::Frame f;
     f.stamp_ns = stamp_ns;
     for (int i = 0; i < 6; ++i) {
       math::SE3 H = rest[i];

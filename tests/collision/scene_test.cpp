@@ -56,7 +56,7 @@ bodies:
   EXPECT_DOUBLE_EQ(s.bodies[1].margin, 0.002);
   EXPECT_LT(s.bodies[0].margin, 0.0);  // scene default applies
   EXPECT_TRUE(s.bodies[2].movable);
-  World w;
+  CollisionWorld w;
   w.addScene(s);
   EXPECT_DOUBLE_EQ(w.activationDistance(), 0.03);
   EXPECT_DOUBLE_EQ(w.margin(w.findBody("scene/floor")), 0.001);
@@ -181,7 +181,7 @@ TEST(Scene, ShippedScenesLoadAndCockpitPanelIsDense) {
     if (entry.path().extension() != ".yaml") continue;
     const SceneSpec s = loadScene(entry.path().string());
     EXPECT_FALSE(s.bodies.empty()) << entry.path();
-    World w;
+    CollisionWorld w;
     w.addScene(s);
     ContactSet cs;
     w.query(0, cs);  // movable objects rest where the file puts them: nothing deeply inside

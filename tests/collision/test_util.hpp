@@ -35,7 +35,7 @@ inline TriangleMesh boxMesh(double h) {
 }
 
 /// World position of a contact's witness point on body a / b.
-inline Vector3 worldA(const World& w, const Contact& c) { return w.bodyPose(c.body_a).act(c.point_a); }
-inline Vector3 worldB(const World& w, const Contact& c) { return w.bodyPose(c.body_b).act(c.point_b); }
+inline Vector3 worldA(const CollisionWorld& w, const Contact& c) { return w.bodyPose(c.body_a).act(c.point_a); }
+inline Vector3 worldB(const CollisionWorld& w, const Contact& c) { return w.bodyPose(c.body_b).act(c.point_b); }
 
 }  // namespace mannequin::collision::test

@@ -23,15 +23,15 @@ constexpr double kPi = 3.14159265358979323846;
 SE3 at(const Vector3& p, const math::Matrix3& R = math::Matrix3::Identity()) { return SE3(R, p); }
 math::Matrix3 rotY(double a) { return rpy(0, a, 0); }
 
-World floorWorld(double activation = 1.0) {
+CollisionWorld floorWorld(double activation = 1.0) {
   WorldOptions o;
   o.activation_distance = activation;
-  World w(o);
+  CollisionWorld w(o);
   w.addBody("scene/floor", {{Shape::plane(Vector3::UnitZ(), 0.0), SE3()}}, SE3(), BodyKind::kStatic);
   return w;
 }
 
-std::vector<Contact> between(const World& w, const ContactSet& cs, const std::string& a, const std::string& b) {
+std::vector<Contact> between(const CollisionWorld& w, const ContactSet& cs, const std::string& a, const std::string& b) {
   std::vector<Contact> out;
   for (const auto& c : cs.contacts)
     if (w.bodyName(c.body_a) == a && w.bodyName(c.body_b) == b) out.push_back(c);
@@ -39,7 +39,7 @@ std::vector<Contact> between(const World& w, const ContactSet& cs, const std::st
 }
 
 // every contact: unit normal and distance == n·(pb − pa) in the world
-void expectConsistent(const World& w, const ContactSet& cs) {
+void expectConsistent(const CollisionWorld& w, const ContactSet& cs) {
   for (const auto& c : cs.contacts) {
     EXPECT_LT(c.body_a, c.body_b);
     EXPECT_NEAR(c.normal.norm(), 1.0, 1e-12);
@@ -55,8 +55,8 @@ skeleton::Model mannequinModel(const char* name = "male_50th") {
 
 }  // namespace
 
-TEST(World, CapsuleUprightOnPlaneOnePoint) {
-  World w = floorWorld(0.3);  // the upper end (0.65 m up) is out of range
+TEST(CollisionWorld, CapsuleUprightOnPlaneOnePoint) {
+  CollisionWorld w = floorWorld(0.3);  // the upper end (0.65 m up) is out of range
   const int cap = w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}}, at({0.1, 0.2, 0.5}), BodyKind::kMovable);
   ContactSet cs;
   w.query(7, cs);
@@ -71,8 +71,8 @@ TEST(World, CapsuleUprightOnPlaneOnePoint) {
   EXPECT_TRUE(c.point_b.isApprox(Vector3(0, 0, -0.25)));
 }
 
-TEST(World, CapsuleLyingOnPlaneTwoPointsTiltedOne) {
-  World w = floorWorld();
+TEST(CollisionWorld, CapsuleLyingOnPlaneTwoPointsTiltedOne) {
+  CollisionWorld w = floorWorld();
   const int cap = w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}}, at({0.3, 0, 0.08}, rotY(kPi / 2)),
                             BodyKind::kMovable);
   ContactSet cs;
@@ -96,10 +96,10 @@ TEST(World, CapsuleLyingOnPlaneTwoPointsTiltedOne) {
   expectConsistent(w, cs);
 }
 
-TEST(World, CapsuleBoxFaceEdgeAndPenetration) {
+TEST(CollisionWorld, CapsuleBoxFaceEdgeAndPenetration) {
   WorldOptions o;
   o.activation_distance = 0.1;
-  World w(o);
+  CollisionWorld w(o);
   w.addBody("box", {{Shape::box({1.0, 0.6, 0.2}), SE3()}}, SE3(), BodyKind::kStatic);
   // lying along y on the top face, 4 cm above: the two ends
   const int cap = w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}},
@@ -136,10 +136,10 @@ TEST(World, CapsuleBoxFaceEdgeAndPenetration) {
   EXPECT_TRUE(c.point_b.isApprox(Vector3(0, 0, -0.15) - 0.02 * Vector3(0.6, 0, 0.8), 1e-9));
 }
 
-TEST(World, SphereMeshFaceAndCorner) {
+TEST(CollisionWorld, SphereMeshFaceAndCorner) {
   WorldOptions o;
   o.activation_distance = 0.05;
-  World w(o);
+  CollisionWorld w(o);
   auto mesh = std::make_shared<const TriangleMesh>(test::boxMesh(0.5));
   const SE3 pose = at({1, 0, 0}, rpy(0, 0, kPi / 2));  // a quarter turn: same cube, other frame
   const int m = w.addBody("mesh", {{Shape::fromMesh(mesh), SE3()}}, pose, BodyKind::kStatic);
@@ -169,10 +169,10 @@ TEST(World, SphereMeshFaceAndCorner) {
   expectConsistent(w, cs);
 }
 
-TEST(World, CapsuleLyingOnMeshTwoPoints) {
+TEST(CollisionWorld, CapsuleLyingOnMeshTwoPoints) {
   WorldOptions o;
   o.activation_distance = 0.02;
-  World w(o);
+  CollisionWorld w(o);
   auto mesh = std::make_shared<const TriangleMesh>(test::boxMesh(0.5));
   w.addBody("mesh", {{Shape::fromMesh(mesh), SE3()}}, SE3(), BodyKind::kStatic);
   w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}}, at({0.1, 0.1, 0.5 + 0.05 + 0.01}, rotY(kPi / 2)),
@@ -193,8 +193,8 @@ TEST(World, CapsuleLyingOnMeshTwoPoints) {
   expectConsistent(w, cs);
 }
 
-TEST(World, BoxRestingOnPlaneFourCorners) {
-  World w = floorWorld(0.02);
+TEST(CollisionWorld, BoxRestingOnPlaneFourCorners) {
+  CollisionWorld w = floorWorld(0.02);
   const int box = w.addBody("box", {{Shape::box({0.4, 0.3, 0.2}), SE3()}}, at({1, 2, 0.105}, rpy(0, 0, 0.3)),
                             BodyKind::kMovable);
   ContactSet cs;
@@ -214,10 +214,10 @@ TEST(World, BoxRestingOnPlaneFourCorners) {
   expectConsistent(w, cs);
 }
 
-TEST(World, BoxOnTableBoxFourCorners) {
+TEST(CollisionWorld, BoxOnTableBoxFourCorners) {
   WorldOptions o;
   o.activation_distance = 0.02;
-  World w(o);
+  CollisionWorld w(o);
   w.addBody("table", {{Shape::box({1.2, 0.8, 0.04}), at({0, 0, 0.73})}}, SE3(), BodyKind::kStatic);
   const int box = w.addBody("box", {{Shape::box({0.2, 0.2, 0.1}), SE3()}}, at({0.1, 0.1, 0.75 + 0.05 + 0.004}),
                             BodyKind::kMovable);
@@ -234,9 +234,9 @@ TEST(World, BoxOnTableBoxFourCorners) {
   expectConsistent(w, cs);
 }
 
-TEST(World, MarginsShiftByTwiceTheMargin) {
+TEST(CollisionWorld, MarginsShiftByTwiceTheMargin) {
   auto make = [](double margin) {
-    World w = floorWorld();
+    CollisionWorld w = floorWorld();
     w.setMargin(0, margin);
     w.addBody("cap", {{Shape::capsule(0.05, 0.4), SE3()}}, at({0.3, 0, 0.08}, rotY(1.4)), BodyKind::kMovable,
               margin);
@@ -244,7 +244,7 @@ TEST(World, MarginsShiftByTwiceTheMargin) {
               BodyKind::kMovable, margin);
     return w;
   };
-  World w0 = make(0.0), w1 = make(0.003);
+  CollisionWorld w0 = make(0.0), w1 = make(0.003);
   ContactSet c0, c1;
   w0.query(0, c0);
   w1.query(0, c1);
@@ -257,7 +257,7 @@ TEST(World, MarginsShiftByTwiceTheMargin) {
   }
   expectConsistent(w1, c1);
   // one margin only: shift by that margin
-  World w2 = make(0.0);
+  CollisionWorld w2 = make(0.0);
   w2.setMargin(0, 0.004);
   ContactSet c2;
   w2.query(0, c2);
@@ -266,11 +266,11 @@ TEST(World, MarginsShiftByTwiceTheMargin) {
     EXPECT_NEAR(c2.contacts[k].distance, c0.contacts[k].distance - 0.004, 1e-15);
 }
 
-TEST(World, StandingMannequinFeetFlatFourPointsEach) {
+TEST(CollisionWorld, StandingMannequinFeetFlatFourPointsEach) {
   const auto model = mannequinModel();
   skeleton::Data data(model);
   skeleton::forwardKinematics(model, data, skeleton::standingConfiguration(model));
-  World w = floorWorld(0.01);  // the shanks' lower ends are 2 cm above the floor
+  CollisionWorld w = floorWorld(0.01);  // the shanks' lower ends are 2 cm above the floor
   const int m = w.addMannequin(model);
   w.updateMannequin(m, data);
   ContactSet cs;
@@ -287,12 +287,12 @@ TEST(World, StandingMannequinFeetFlatFourPointsEach) {
   expectConsistent(w, cs);
 }
 
-TEST(World, AdjacentSegmentsNeverReportedSelfContactsAre) {
+TEST(CollisionWorld, AdjacentSegmentsNeverReportedSelfContactsAre) {
   const auto model = mannequinModel();
   skeleton::Data data(model);
   WorldOptions o;
   o.activation_distance = 0.05;
-  World w(o);
+  CollisionWorld w(o);
   const int m = w.addMannequin(model);
   const std::vector<std::pair<std::string, std::string>> adjacent = {
       {"pelvis", "abdomen"}, {"abdomen", "thorax"}, {"thorax", "head"}, {"thorax", "clavicle_l"},
@@ -324,7 +324,7 @@ TEST(World, AdjacentSegmentsNeverReportedSelfContactsAre) {
   EXPECT_GT(self_contacts, 50);  // self-collision is on and does fire
 }
 
-TEST(World, TwoMannequinsCollide) {
+TEST(CollisionWorld, TwoMannequinsCollide) {
   const auto model = mannequinModel();
   skeleton::Data d0(model), d1(model);
   auto q = skeleton::standingConfiguration(model);
@@ -332,7 +332,7 @@ TEST(World, TwoMannequinsCollide) {
   q[0] += 0.25;  // the second one 25 cm ahead, turned around: they overlap
   q[5] = kPi;
   skeleton::forwardKinematics(model, d1, q);
-  World w = floorWorld(0.02);
+  CollisionWorld w = floorWorld(0.02);
   const int a = w.addMannequin(model);
   const int b = w.addMannequin(model);
   EXPECT_EQ(w.mannequinCount(), 2);
@@ -348,17 +348,17 @@ TEST(World, TwoMannequinsCollide) {
   expectConsistent(w, cs);
 }
 
-TEST(World, DeterministicWhateverTheHistory) {
+TEST(CollisionWorld, DeterministicWhateverTheHistory) {
   const auto model = mannequinModel();
   skeleton::Data data(model);
   auto build = [&] {
-    World w = floorWorld(0.05);
+    CollisionWorld w = floorWorld(0.05);
     w.addBody("scene/table", {{Shape::box({1.2, 0.8, 0.04}), at({0.5, 0, 0.73})}}, SE3(), BodyKind::kStatic);
     w.addMannequin(model);
     w.addBody("scene/ball", {{Shape::sphere(0.1), SE3()}}, at({0.5, 0, 0.85}), BodyKind::kMovable);
     return w;
   };
-  World w1 = build(), w2 = build();
+  CollisionWorld w1 = build(), w2 = build();
   const auto q0 = skeleton::standingConfiguration(model);
   std::mt19937 g(11);
   std::normal_distribution<double> n(0.0, 0.4);
@@ -396,8 +396,8 @@ TEST(World, DeterministicWhateverTheHistory) {
   }
 }
 
-TEST(World, BadArgumentsThrowClearly) {
-  World w = floorWorld();
+TEST(CollisionWorld, BadArgumentsThrowClearly) {
+  CollisionWorld w = floorWorld();
   EXPECT_THROW(w.setBodyPose(0, SE3()), std::invalid_argument);  // static
   const int b = w.addBody("b", {{Shape::sphere(0.1), SE3()}}, SE3(), BodyKind::kMovable);
   SE3 bad;

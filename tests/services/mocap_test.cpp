@@ -12,10 +12,19 @@
 #include "mannequin/mocap/dtrack2.hpp"
 #include "mannequin/mocap/synthetic_source.hpp"
 #include "mannequin/skeleton/bvh.hpp"
+#include "mannequin/transport/convert.hpp"
 #include "mannequin/transport/validate.hpp"
 
 using namespace mannequin;
 using namespace mannequin::mocap;
+
+namespace {
+v1::MocapFrame wire(const Frame& f, const std::string& kind) {
+  v1::MocapFrame m;
+  transport::toMsg(f, kind, m);
+  return m;
+}
+}  // namespace
 
 namespace {
 // A datagram as ART DTrack2 sends it (one body, id 45), CR LF line ends.
@@ -32,7 +41,7 @@ core::ConfigNode configOf(const std::string& text) { return core::ConfigNode::pa
 }  // namespace
 
 TEST(DTrack2, ParsesARealDatagram) {
-  DTrackFrame f;
+  DTrackDatagram f;
   ASSERT_EQ(parseDTrack(kRealDatagram, f), "");
   EXPECT_EQ(f.frame_counter.value(), 518169u);
   EXPECT_DOUBLE_EQ(f.timestamp.value(), 30331.359222);
@@ -49,7 +58,7 @@ TEST(DTrack2, ParsesARealDatagram) {
 }
 
 TEST(DTrack2, AcceptsLfLinesThreeValuePositionsAndSkipsOtherRecords) {
-  DTrackFrame f;
+  DTrackDatagram f;
   const std::string d =
       "fr 7\n6df2 1 1 [0 1.000 2 2][1 2 3][1 0 0 0 1 0 0 0 1][0 0.0 0.0]\n"
       "6d 2 [0 0.5][100 200 300][1 0 0 0 1 0 0 0 1] [3 -1.000][0 0 0][1 0 0 0 1 0 0 0 1]\n3d 0\n";
@@ -80,13 +89,13 @@ TEST(DTrack2, RejectsMalformedDatagramsNamingTheLine) {
       {std::string("fr 1\n6d 0\x01\n"), "control character"},
   };
   for (const auto& c : cases) {
-    DTrackFrame f;
+    DTrackDatagram f;
     const std::string why = parseDTrack(c.text, f);
     EXPECT_NE(why.find(c.expect), std::string::npos) << "datagram: " << c.text << "\nerror: " << why;
   }
 }
 
-TEST(DTrack2, LoopbackUdpDatagramsBecomeSamples) {
+TEST(DTrack2, LoopbackUdpDatagramsBecomeFrames) {
   DTrackOptions o;
   o.port = 0;  // ephemeral
   o.bodies = {{45, "head"}, {3, "hand_l"}};
@@ -97,7 +106,7 @@ TEST(DTrack2, LoopbackUdpDatagramsBecomeSamples) {
   const asio::ip::udp::endpoint to(asio::ip::make_address("127.0.0.1"), static_cast<unsigned short>(source.port()));
   tx.send_to(asio::buffer(std::string("garbage that is not DTrack\r\n")), to);
   tx.send_to(asio::buffer(kRealDatagram), to);
-  std::optional<Sample> s;
+  std::optional<Frame> s;
   for (int k = 0; k < 100 && !s; ++k) s = source.next(std::chrono::milliseconds(20));
   ASSERT_TRUE(s.has_value());
   EXPECT_EQ(source.malformedDatagrams(), 1u);
@@ -109,7 +118,7 @@ TEST(DTrack2, LoopbackUdpDatagramsBecomeSamples) {
   EXPECT_LT((s->bodies[0].pose.p - math::Vector3(-0.005026, 0.695186, 0.763716)).norm(), 1e-12);  // mm → m
   EXPECT_EQ(s->bodies[1].name, "hand_l");
   EXPECT_FALSE(s->bodies[1].tracked);  // not in the datagram
-  EXPECT_EQ(transport::validateMocapFrame(toMessage(*s, "dtrack2")), "");
+  EXPECT_EQ(transport::validateMocapFrame(wire(*s, "dtrack2")), "");
   // next frame: head lost (quality −1), hand seen; the head keeps its last pose, untracked
   tx.send_to(asio::buffer(std::string("fr 518170\r\n6d 2 [45 -1.000][0 0 0][1 0 0 0 1 0 0 0 1]"
                                       "[3 0.800][10 20 30][0 1 0 -1 0 0 0 0 1]\r\n")),
@@ -140,7 +149,7 @@ TEST(BvhSource, PublishesTheForwardKinematicsInTheRoomFrame) {
   const skeleton::Bvh bvh = skeleton::readBvhFile(o.file, ro);
   const auto world11 = skeleton::bvhWorldPoses(bvh, 11, skeleton::BvhLengthUnit::Metre);
   const int wrist = skeleton::findBvhJoint(bvh, "LeftWrist");
-  std::vector<Sample> got;
+  std::vector<Frame> got;
   for (int k = 0; k < 7; ++k) got.push_back(*src.next(std::chrono::milliseconds(0)));
   EXPECT_TRUE(got[0].calibration_pose);
   EXPECT_FALSE(got[1].calibration_pose);
@@ -195,17 +204,35 @@ TEST(Synthetic, HandCheckablePositionsAndOcclusion) {
   o.bodies = {b};
   o.occlusions = {{"hand_l", 0.5, 0.6}};
   SyntheticSource src(o);
-  const Sample s100 = src.sampleAt(100);
+  const Frame s100 = src.frameAt(100);
   EXPECT_LT((s100.bodies[0].pose.p - math::Vector3(1.5, 2, 2.8)).norm(), 1e-12);
   EXPECT_EQ(s100.stamp_ns, 1000000000);
-  EXPECT_TRUE(src.sampleAt(49).bodies[0].tracked);
-  EXPECT_FALSE(src.sampleAt(50).bodies[0].tracked);
-  EXPECT_FALSE(src.sampleAt(59).bodies[0].tracked);
-  EXPECT_TRUE(src.sampleAt(60).bodies[0].tracked);
+  EXPECT_TRUE(src.frameAt(49).bodies[0].tracked);
+  EXPECT_FALSE(src.frameAt(50).bodies[0].tracked);
+  EXPECT_FALSE(src.frameAt(59).bodies[0].tracked);
+  EXPECT_TRUE(src.frameAt(60).bodies[0].tracked);
   int n = 0;
   while (src.next(std::chrono::milliseconds(0))) ++n;
   EXPECT_EQ(n, 101);  // t = 0 .. 1 s inclusive
   EXPECT_TRUE(src.finished());
+}
+
+TEST(MocapConfig, ShippedFilesAreFoundFromAnotherWorkingDirectory) {
+  const std::filesystem::path old = std::filesystem::current_path();
+  std::filesystem::current_path(std::filesystem::temp_directory_path());
+  std::unique_ptr<Source> bvh;
+  std::string error;
+  try {
+    bvh = makeSource(configOf(
+        "source: bvh\nbvh:\n  file: data/bvh/cmu_max_131_03.bvh\n  map: configs/mappings/cmu.yaml\n  bodies: [pelvis]\n"));
+    makeSource(configOf("source: bvh\nbvh:\n  file: data/bvh/nothing_here.bvh\n  bodies: {pelvis: Hips}\n"));
+  } catch (const core::ConfigError& e) {
+    error = e.what();
+  }
+  std::filesystem::current_path(old);
+  ASSERT_NE(bvh, nullptr) << error;
+  EXPECT_EQ(bvh->kind(), "bvh");
+  EXPECT_NE(error.find("test.yaml:3: field 'bvh.file': data/bvh/nothing_here.bvh: not found"), std::string::npos) << error;
 }
 
 TEST(MocapConfig, BuildsSourcesAndNamesFileLineAndField) {

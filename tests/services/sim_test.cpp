@@ -27,8 +27,8 @@ math::SE3 pose(const math::Vector3& p, const math::Vector3& r = math::Vector3::Z
   return H;
 }
 
-MocapInput frame(std::int64_t stamp_ns, std::vector<BodyInput> bodies) {
-  MocapInput f;
+mocap::Frame frame(std::int64_t stamp_ns, std::vector<mocap::Body> bodies) {
+  mocap::Frame f;
   f.stamp_ns = stamp_ns;
   f.sequence = static_cast<std::uint64_t>(stamp_ns / 1000000 + 1);
   f.bodies = std::move(bodies);

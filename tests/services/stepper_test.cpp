@@ -13,7 +13,7 @@
 #include "mannequin/math/so3.hpp"
 #include "mannequin/mocap/source.hpp"
 #include "mannequin/core/config.hpp"
-#include "mannequin/simservice/messages.hpp"
+#include "mannequin/transport/convert.hpp"
 #include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
@@ -22,6 +22,12 @@ using namespace mannequin;
 using namespace mannequin::sim;
 
 namespace {
+v1::MocapFrame toWire(const mocap::Frame& f, const std::string& kind) {
+  v1::MocapFrame m;
+  transport::toMsg(f, kind, m);
+  return m;
+}
+
 const skeleton::Model& male50() {
   static const skeleton::Model m = skeleton::buildMannequin(skeleton::loadMannequinSpec("configs/mannequins/male_50th.yaml"));
   return m;
@@ -178,9 +184,9 @@ TEST(World, TheControllerStepperCalibratesAndTracks) {
   const math::SE3 place(math::expSO3(math::Vector3(0, 0, M_PI / 2)), math::Vector3(2, 1, 0));
   auto body = [&](const std::string& f, const math::Vector3& dp = math::Vector3::Zero()) {
     const math::SE3 H = place * d.oMf[male50().frameIndex(f)];
-    return BodyInput{f, math::SE3(H.R, H.p + dp), true};
+    return mocap::Body{f, math::SE3(H.R, H.p + dp), true};
   };
-  MocapInput f0;
+  mocap::Frame f0;
   f0.stamp_ns = 0;
   f0.bodies = {body("pelvis"), body("foot_l"), body("foot_r"), body("hand_l"), body("hand_r"), body("head")};
   w.addMocap(f0);
@@ -192,7 +198,7 @@ TEST(World, TheControllerStepperCalibratesAndTracks) {
     EXPECT_LT(st.orientation_error, 1e-6) << st.frame;
   }
   // the hand body rises 10 cm: the mannequin's hand follows
-  MocapInput f1 = f0;
+  mocap::Frame f1 = f0;
   f1.stamp_ns = 1'000'000'000;
   f1.bodies[3] = body("hand_l", math::Vector3(0, 0, 0.1));
   w.addMocap(f1);
@@ -237,7 +243,7 @@ CaptureRun runCapture(bool controller) {
     const auto s = source->next(std::chrono::microseconds(0));
     if (!s) continue;
     // as the cluster carries it: the mocap service's message, decoded by the sim service
-    const MocapInput in = simservice::toInput(mocap::toMessage(*s, source->kind()));
+    const mocap::Frame in = transport::fromMsg(toWire(*s, source->kind()));
     w.addMocap(in);
     if (!w.anchored()) w.anchor(in.stamp_ns);
     while (w.captureTimeNs() < in.stamp_ns) {

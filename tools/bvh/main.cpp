@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "mannequin/core/main.hpp"
 #include "mannequin/skeleton/bvh.hpp"
 
 namespace sk = mannequin::skeleton;
@@ -201,27 +202,16 @@ int main(int argc, char** argv) {
       args.erase(args.begin() + static_cast<std::ptrdiff_t>(i) + 1);
     }
   }
-  std::reverse(args.begin(), args.end());  // CLI11 takes the vector in reverse order
-
-  try {
-    app.parse(args);
-  } catch (const CLI::CallForHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::CallForAllHelp& e) {
-    return app.exit(e);
-  } catch (const CLI::ParseError& e) {
-    std::cerr << "mannequin-bvh: " << e.what() << " (see --help)\n";
-    return kExitUsage;
-  }
-
-  try {
-    if (info->parsed()) return runInfo(info_file, info_json);
-    return runPoses(poses_file, poses_frames, poses_json);
-  } catch (const UsageError& e) {
-    std::cerr << "mannequin-bvh: " << e.what() << "\n";
-    return kExitUsage;
-  } catch (const sk::BvhError& e) {
-    std::cerr << "mannequin-bvh: " << e.what() << "\n";
-    return kExitData;
-  }
+  return mannequin::core::runMain(app, args, [&] {
+    try {
+      if (info->parsed()) return runInfo(info_file, info_json);
+      return runPoses(poses_file, poses_frames, poses_json);
+    } catch (const UsageError& e) {  // the outcomes the help promises, with their own messages
+      std::cerr << "mannequin-bvh: " << e.what() << "\n";
+      return kExitUsage;
+    } catch (const sk::BvhError& e) {
+      std::cerr << "mannequin-bvh: " << e.what() << "\n";
+      return kExitData;
+    }
+  });
 }

@@ -1,5 +1,4 @@
 // mannequin-drive: drives a mannequin with a BVH capture (orientation transfer) and prints a summary.
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include <chrono>
@@ -7,11 +6,14 @@
 #include <fstream>
 #include <iostream>
 
+#include "mannequin/core/main.hpp"
+#include "mannequin/core/paths.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/bvh_drive.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 
 using namespace mannequin::skeleton;
+namespace core = mannequin::core;
 
 namespace {
 struct Range {
@@ -28,22 +30,16 @@ int main(int argc, char** argv) {
   std::string out_csv;
   bool json = false, per_segment = false;
   app.add_option("bvh", bvh_path, "BVH file")->required()->check(CLI::ExistingFile);
-  app.add_option("--mannequin", mannequin_path, "mannequin config (YAML)")->capture_default_str()->check(CLI::ExistingFile);
-  app.add_option("--map", map_path, "BVH-joint to segment mapping (YAML)")->capture_default_str()->check(CLI::ExistingFile);
+  app.add_option("--mannequin", mannequin_path, "mannequin config (YAML; relative paths also from the checkout)")->capture_default_str();
+  app.add_option("--map", map_path, "BVH-joint to segment mapping (YAML; relative paths also from the checkout)")->capture_default_str();
   app.add_option("--out", out_csv, "write the configuration of every frame as CSV");
   app.add_flag("--json", json, "print the summary as JSON");
   app.add_flag("--segments", per_segment, "also print the orientation error of each driven segment");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
 
-  try {
-    const MannequinSpec spec = loadMannequinSpec(mannequin_path);
+  return core::runMain(app, argc, argv, [&] {
+    const MannequinSpec spec = loadMannequinSpec(core::findData(mannequin_path));
     const Model model = buildMannequin(spec);
-    const BvhDriveMap map = loadBvhDriveMap(map_path);
+    const BvhDriveMap map = loadBvhDriveMap(core::findData(map_path));
     BvhReadOptions options;
     options.unit_scale_to_m = map.unit_scale_to_m;
     const Bvh bvh = readBvhFile(bvh_path, options);
@@ -128,8 +124,5 @@ int main(int argc, char** argv) {
       if (!out_csv.empty()) std::printf("wrote      %s (%d rows x %d coordinates)\n", out_csv.c_str(), bvh.num_frames, model.nq);
     }
     return 0;
-  } catch (const std::exception& e) {
-    spdlog::critical("{}", e.what());
-    return 1;
-  }
+  });
 }

@@ -1,5 +1,4 @@
 // mannequin-lcp: solve an LCP read from a plain-text file (format in docs/lcp.md).
-#include <CLI/CLI.hpp>
 
 #include <cmath>
 #include <cstdio>
@@ -8,6 +7,7 @@
 #include <sstream>
 #include <string>
 
+#include "mannequin/core/main.hpp"
 #include "mannequin/lcp/io.hpp"
 #include "mannequin/lcp/lemke.hpp"
 #include "mannequin/lcp/pgs.hpp"
@@ -76,6 +76,8 @@ int report(bool json, const char* status, const Eigen::VectorXd& z, int pivots, 
   return code;
 }
 
+int run(const std::string& file, const std::string& solver, bool json);
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -88,14 +90,12 @@ int main(int argc, char** argv) {
   solve->add_option("--solver", solver, "lemke | pgs | structured")
       ->check(CLI::IsMember({"lemke", "pgs", "structured"}));
   solve->add_flag("--json", json, "print one JSON object");
-  // a bad command line exits with 2, like every mannequin tool (CLI11's own codes are > 100)
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
+  return mannequin::core::runMain(app, argc, argv, [&] { return run(file, solver, json); });
+}
 
+namespace {
+
+int run(const std::string& file, const std::string& solver, bool json) {
   // read and parse
   std::ifstream in(file);
   if (!in) return report(json, "invalid", {}, 0, 0.0, nullptr, "cannot open " + file, 2);
@@ -133,3 +133,5 @@ int main(int argc, char** argv) {
   return report(json, publicStatus(r.status), r.z, r.pivots, r.residuals.complementarity,
                 &r.residuals, std::string(r.message) + note, code);
 }
+
+}  // namespace

@@ -1,6 +1,5 @@
 // mannequin-record: subscribes to the cluster's topics (endpoints from the deployment file) and
 // writes every message, as received, into an MCAP file (docs/recording.md).
-#include <CLI/CLI.hpp>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
@@ -9,6 +8,7 @@
 #include <set>
 
 #include "cluster_io.hpp"
+#include "mannequin/core/main.hpp"
 #include "mannequin/proto/schema.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
 #include "mannequin/transport/clock.hpp"
@@ -42,19 +42,12 @@ int main(int argc, char** argv) {
       ->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--progress", progress, "log progress every this many seconds (0 = never)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
-  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")->capture_default_str();
-  try {
-    app.parse(argc, argv);
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")->capture_default_str()->check(core::logLevelCheck());
+  return core::runMain(app, argc, argv, [&] {
     if (deployment.empty() && connect.empty()) throw CLI::ValidationError("give a deployment file or --connect ENDPOINT");
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
-  spdlog::set_default_logger(spdlog::stderr_color_mt("record"));  // logs on stderr, --info on stdout
-  spdlog::set_level(spdlog::level::from_str(log_level));
-  spdlog::set_pattern("[%H:%M:%S.%e] [record] %^%l%$ %v");
-  try {
-    const auto& stop = tools::stopOnSignals();
+    core::setupLogging(log_level);
+    spdlog::set_pattern("[%H:%M:%S.%e] [record] %^%l%$ %v");
+    const auto& stop = core::installStopSignals();
     std::vector<std::string> endpoints = connect;
     if (!deployment.empty()) {
       for (const std::string& e : tools::publishEndpoints(deployment, run_dir)) endpoints.push_back(e);
@@ -147,8 +140,5 @@ int main(int argc, char** argv) {
     spdlog::info("done: {} messages on {} topics, {:.2f} MB in {}", writer.messageCount(), channels.size(),
                  writer.bytesWritten() / 1e6, out);
     return 0;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  }
+  });
 }

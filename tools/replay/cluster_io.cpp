@@ -4,7 +4,6 @@
 #include <google/protobuf/wire_format_lite.h>
 
 #include <algorithm>
-#include <csignal>
 #include <stdexcept>
 
 #include <mannequin/v1/header.pb.h>
@@ -12,16 +11,6 @@
 #include "mannequin/deploy/deployment.hpp"
 
 namespace mannequin::tools {
-
-namespace {
-
-std::atomic<bool> g_stop{false};  // lock-free: safe to set from a signal handler
-
-void onSignal(int) {
-  g_stop.store(true);
-}
-
-}  // namespace
 
 std::vector<std::string> publishEndpoints(const std::string& deployment_file, const std::string& run_dir,
                                           const std::vector<std::string>& names) {
@@ -82,13 +71,6 @@ std::vector<std::string> splitList(const std::string& s) {
   }
   push();
   return out;
-}
-
-const std::atomic<bool>& stopOnSignals() {
-  std::signal(SIGINT, onSignal);
-  std::signal(SIGTERM, onSignal);
-  std::signal(SIGPIPE, SIG_IGN);
-  return g_stop;
 }
 
 }  // namespace mannequin::tools

@@ -1,6 +1,6 @@
 #pragma once
 // What mannequin-record and mannequin-replay share: endpoints from a deployment file, the Header
-// of a raw payload, the schema of a topic, signals.
+// of a raw payload, the schema of a topic.
 #include <atomic>
 #include <cstdint>
 #include <optional>
@@ -29,8 +29,5 @@ std::optional<RawHeader> parseHeader(std::string_view payload);
 
 /// "a,b , c" -> {"a","b","c"} (empty parts dropped).
 std::vector<std::string> splitList(const std::string& s);
-
-/// SIGINT/SIGTERM set the returned flag; SIGPIPE ignored.
-const std::atomic<bool>& stopOnSignals();
 
 }  // namespace mannequin::tools

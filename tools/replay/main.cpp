@@ -1,7 +1,6 @@
 // mannequin-replay: publishes the messages of an MCAP recording back onto the cluster, with the
 // original timing (or a rate factor), looped, ranged, filtered by topic, paused/stepped from the
 // terminal, or in lockstep with a consumer (docs/recording.md).
-#include <CLI/CLI.hpp>
 #include <fmt/format.h>
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -13,6 +12,7 @@
 #include <thread>
 
 #include "cluster_io.hpp"
+#include "mannequin/core/main.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
 #include "mannequin/recording/replay.hpp"
 #include "mannequin/transport/publisher.hpp"
@@ -95,9 +95,8 @@ int main(int argc, char** argv) {
   app.add_flag("--info", info, "print what the file holds and exit");
   app.add_option("--progress", progress, "log progress every this many seconds (0 = never)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
-  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")->capture_default_str();
-  try {
-    app.parse(argc, argv);
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")->capture_default_str()->check(core::logLevelCheck());
+  return core::runMain(app, argc, argv, [&] {
     if ((!as_services.empty() || !ack_from.empty()) && deployment.empty()) {
       throw CLI::ValidationError("--as and --ack-from need --deployment FILE");
     }
@@ -108,14 +107,8 @@ int main(int argc, char** argv) {
       throw CLI::ValidationError("--lockstep needs --ack-connect ENDPOINT or --ack-from SERVICE");
     }
     if (end >= 0 && end < start) throw CLI::ValidationError("--end is before --start");
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
-  spdlog::set_default_logger(spdlog::stderr_color_mt("replay"));  // logs on stderr, --info on stdout
-  spdlog::set_level(spdlog::level::from_str(log_level));
-  spdlog::set_pattern("[%H:%M:%S.%e] [replay] %^%l%$ %v");
-  try {
+    core::setupLogging(log_level);
+    spdlog::set_pattern("[%H:%M:%S.%e] [replay] %^%l%$ %v");
     const recording::McapReader reader = recording::McapReader::open(file);
     if (info) {
       printInfo(reader, file);
@@ -142,7 +135,7 @@ int main(int argc, char** argv) {
     if (!ack_from.empty()) {
       for (const std::string& e : tools::publishEndpoints(deployment, run_dir, {ack_from})) ack_connect.push_back(e);
     }
-    const auto& stop = tools::stopOnSignals();
+    const auto& stop = core::installStopSignals();
     zmq::context_t context;
     transport::Publisher pub(context, {"replay", publish});
     spdlog::info("{}: {} messages, {:.1f} s; publishing on {}", file, stats.message_count,
@@ -219,11 +212,5 @@ int main(int argc, char** argv) {
                  result.quit ? ", stopped by the user" : "",
                  acks ? fmt::format(", lockstep: {} waits, {} timeouts", waited, ack_timeouts) : std::string());
     return 0;
-  } catch (const recording::McapError& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  } catch (const std::exception& e) {
-    spdlog::error("{}", e.what());
-    return 1;
-  }
+  });
 }

@@ -1,12 +1,13 @@
 // mannequin-retarget: retargets a BVH capture onto a mannequin with the strict-priority IK and
 // writes the mannequin's motion as BVH; prints per-level residual statistics.
-#include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cstdio>
 
+#include "mannequin/core/main.hpp"
+#include "mannequin/core/paths.hpp"
 #include "mannequin/ik/retarget.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/bvh_write.hpp"
@@ -21,25 +22,19 @@ int main(int argc, char** argv) {
   long long start = 0, end = -1;
   int max_iterations = 30;
   app.add_option("bvh", in_path, "input BVH capture")->required()->check(CLI::ExistingFile);
-  app.add_option("--mannequin", mannequin_path, "mannequin config (YAML)")->capture_default_str()->check(CLI::ExistingFile);
-  app.add_option("--map", map_path, "BVH-joint to segment mapping (YAML)")->capture_default_str()->check(CLI::ExistingFile);
+  app.add_option("--mannequin", mannequin_path, "mannequin config (YAML; relative paths also from the checkout)")->capture_default_str();
+  app.add_option("--map", map_path, "BVH-joint to segment mapping (YAML; relative paths also from the checkout)")->capture_default_str();
   app.add_option("--out", out_path, "output BVH file (the mannequin's skeleton and motion)")->required();
   app.add_option("--calibration", calibration, "calibration pose: 'first' (first retargeted frame) or 'rest' (BVH rest pose)")
       ->capture_default_str()->check(CLI::IsMember({"first", "rest"}));
   app.add_option("--start", start, "first frame")->capture_default_str()->check(CLI::NonNegativeNumber);
   app.add_option("--end", end, "frame after the last one (-1: to the end)")->capture_default_str();
   app.add_option("--max-iterations", max_iterations, "IK iterations per frame")->capture_default_str()->check(CLI::Range(1, 1000));
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : 2;
-  }
 
-  try {
-    const skeleton::MannequinSpec spec = skeleton::loadMannequinSpec(mannequin_path);
+  return core::runMain(app, argc, argv, [&] {
+    const skeleton::MannequinSpec spec = skeleton::loadMannequinSpec(core::findData(mannequin_path));
     const skeleton::Model model = skeleton::buildMannequin(spec);
-    const skeleton::BvhDriveMap map = skeleton::loadBvhDriveMap(map_path);
+    const skeleton::BvhDriveMap map = skeleton::loadBvhDriveMap(core::findData(map_path));
     skeleton::BvhReadOptions read_options;
     read_options.unit_scale_to_m = map.unit_scale_to_m;
     const skeleton::Bvh bvh = skeleton::readBvhFile(in_path, read_options);
@@ -99,8 +94,5 @@ int main(int argc, char** argv) {
                 clamped_frames, backtracks);
     std::printf("wrote %s (%zu joints, %lld frames)\n", out_path.c_str(), model.joints.size(), n);
     return 0;
-  } catch (const std::exception& e) {
-    spdlog::critical("{}", e.what());
-    return 1;
-  }
+  });
 }

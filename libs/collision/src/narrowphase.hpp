@@ -1,5 +1,5 @@
 #pragma once
-// Internal: the narrow phase of World (closest points and contact manifolds of one pair).
+// Internal: the narrow phase of CollisionWorld (closest points and contact manifolds of one pair).
 #include <fcl/geometry/bvh/BVH_model.h>
 #include <fcl/math/bv/OBBRSS.h>
 #include <fcl/narrowphase/detail/gjk_solver_libccd.h>

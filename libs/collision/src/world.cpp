@@ -81,7 +81,7 @@ Matrix3 frameAlong(const Vector3& dir) {
 
 }  // namespace
 
-struct World::Impl {
+struct CollisionWorld::Impl {
   WorldOptions options;
   std::vector<Body> bodies;
   std::vector<Collider> colliders;
@@ -225,7 +225,7 @@ struct World::Impl {
   }
 };
 
-World::World(const WorldOptions& options) : impl_(std::make_unique<Impl>()) {
+CollisionWorld::CollisionWorld(const WorldOptions& options) : impl_(std::make_unique<Impl>()) {
   if (!std::isfinite(options.activation_distance) || options.activation_distance < 0.0)
     throw std::invalid_argument("WorldOptions.activation_distance must be finite and >= 0");
   if (options.max_points_per_pair < 1 || options.max_points_per_pair > 8)
@@ -234,11 +234,11 @@ World::World(const WorldOptions& options) : impl_(std::make_unique<Impl>()) {
     throw std::invalid_argument("WorldOptions.face_angle_deg must be in [0, 90)");
   impl_->options = options;
 }
-World::~World() = default;
-World::World(World&&) noexcept = default;
-World& World::operator=(World&&) noexcept = default;
+CollisionWorld::~CollisionWorld() = default;
+CollisionWorld::CollisionWorld(CollisionWorld&&) noexcept = default;
+CollisionWorld& CollisionWorld::operator=(CollisionWorld&&) noexcept = default;
 
-void World::addScene(const SceneSpec& scene) {
+void CollisionWorld::addScene(const SceneSpec& scene) {
   if (scene.activation_distance >= 0.0) impl_->options.activation_distance = scene.activation_distance;
   for (const auto& b : scene.bodies) {
     addBody("scene/" + b.name, b.shapes, b.pose, b.movable ? BodyKind::kMovable : BodyKind::kStatic,
@@ -246,7 +246,7 @@ void World::addScene(const SceneSpec& scene) {
   }
 }
 
-int World::addBody(const std::string& name, const std::vector<PlacedShape>& shapes, const SE3& pose,
+int CollisionWorld::addBody(const std::string& name, const std::vector<PlacedShape>& shapes, const SE3& pose,
                    BodyKind kind, double margin) {
   auto& I = *impl_;
   if (name.empty()) throw std::invalid_argument("body name is empty");
@@ -269,7 +269,7 @@ int World::addBody(const std::string& name, const std::vector<PlacedShape>& shap
   return id;
 }
 
-int World::addMannequin(const skeleton::Model& model, const MannequinOptions& opt) {
+int CollisionWorld::addMannequin(const skeleton::Model& model, const MannequinOptions& opt) {
   auto& I = *impl_;
   const int index = static_cast<int>(I.mannequins.size());
   MannequinEntry m;
@@ -343,7 +343,7 @@ int World::addMannequin(const skeleton::Model& model, const MannequinOptions& op
   return index;
 }
 
-void World::setBodyPose(int body, const SE3& oMb) {
+void CollisionWorld::setBodyPose(int body, const SE3& oMb) {
   auto& I = *impl_;
   I.checkBody(body);
   Body& b = I.bodies[body];
@@ -354,7 +354,7 @@ void World::setBodyPose(int body, const SE3& oMb) {
   for (int c : b.colliders) I.colliders[c].oMs = oMb * I.colliders[c].bMs;
 }
 
-void World::updateMannequin(int mannequin, const skeleton::Data& data) {
+void CollisionWorld::updateMannequin(int mannequin, const skeleton::Data& data) {
   auto& I = *impl_;
   if (mannequin < 0 || mannequin >= static_cast<int>(I.mannequins.size()))
     throw std::invalid_argument("unknown mannequin " + std::to_string(mannequin));
@@ -371,14 +371,14 @@ void World::updateMannequin(int mannequin, const skeleton::Data& data) {
   }
 }
 
-void World::setMargin(int body, double margin) {
+void CollisionWorld::setMargin(int body, double margin) {
   impl_->checkBody(body);
   if (!std::isfinite(margin) || margin < 0.0) throw std::invalid_argument("margin must be finite and >= 0");
   impl_->bodies[body].margin = margin;
   impl_->dirty = true;
 }
 
-void World::query(std::uint64_t step, ContactSet& out) {
+void CollisionWorld::query(std::uint64_t step, ContactSet& out) {
   auto& I = *impl_;
   out.step = step;
   out.contacts.clear();
@@ -449,41 +449,41 @@ void World::query(std::uint64_t step, ContactSet& out) {
   out.stats.triangles_tested = I.scratch.triangles_tested;
 }
 
-int World::bodyCount() const { return static_cast<int>(impl_->bodies.size()); }
-const std::string& World::bodyName(int body) const {
+int CollisionWorld::bodyCount() const { return static_cast<int>(impl_->bodies.size()); }
+const std::string& CollisionWorld::bodyName(int body) const {
   impl_->checkBody(body);
   return impl_->bodies[body].name;
 }
-int World::findBody(const std::string& name) const {
+int CollisionWorld::findBody(const std::string& name) const {
   const auto it = impl_->by_name.find(name);
   return it == impl_->by_name.end() ? -1 : it->second;
 }
-BodyKind World::bodyKind(int body) const {
+BodyKind CollisionWorld::bodyKind(int body) const {
   impl_->checkBody(body);
   return impl_->bodies[body].kind;
 }
-const SE3& World::bodyPose(int body) const {
+const SE3& CollisionWorld::bodyPose(int body) const {
   impl_->checkBody(body);
   return impl_->bodies[body].oMb;
 }
-double World::margin(int body) const {
+double CollisionWorld::margin(int body) const {
   impl_->checkBody(body);
   return impl_->bodies[body].margin;
 }
-int World::segmentBody(int mannequin, int segment) const {
+int CollisionWorld::segmentBody(int mannequin, int segment) const {
   const auto& ms = impl_->mannequins;
   if (mannequin < 0 || mannequin >= static_cast<int>(ms.size())) return -1;
   const auto& sb = ms[mannequin].segment_body;
   return segment >= 0 && segment < static_cast<int>(sb.size()) ? sb[segment] : -1;
 }
-int World::mannequinCount() const { return static_cast<int>(impl_->mannequins.size()); }
-bool World::pairEnabled(int a, int b) const {
+int CollisionWorld::mannequinCount() const { return static_cast<int>(impl_->mannequins.size()); }
+bool CollisionWorld::pairEnabled(int a, int b) const {
   impl_->checkBody(a);
   impl_->checkBody(b);
   return impl_->pairEnabled(a, b);
 }
-double World::activationDistance() const { return impl_->options.activation_distance; }
-void World::setActivationDistance(double distance) {
+double CollisionWorld::activationDistance() const { return impl_->options.activation_distance; }
+void CollisionWorld::setActivationDistance(double distance) {
   if (!std::isfinite(distance) || distance < 0.0)
     throw std::invalid_argument("activation distance must be finite and >= 0");
   impl_->options.activation_distance = distance;

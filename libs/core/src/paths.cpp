@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <algorithm>
 #include <cstdlib>
 #include <filesystem>
 #include <system_error>
@@ -13,17 +14,21 @@ namespace fs = std::filesystem;
 
 std::vector<std::string> dataSearchDirs() {
   std::vector<std::string> dirs;
+  auto add = [&dirs](const fs::path& d) {  // each directory once, in order
+    const std::string s = d.lexically_normal().string();
+    if (std::find(dirs.begin(), dirs.end(), s) == dirs.end()) dirs.push_back(s);
+  };
   std::error_code ec;
   const fs::path cwd = fs::current_path(ec);
-  if (!ec) dirs.push_back(cwd.string());
-  if (const char* env = std::getenv("MANNEQUIN_SOURCE_DIR"); env != nullptr && *env != '\0') dirs.emplace_back(env);
+  if (!ec) add(cwd);
+  if (const char* env = std::getenv("MANNEQUIN_SOURCE_DIR"); env != nullptr && *env != '\0') add(env);
 #ifdef MANNEQUIN_SOURCE_TREE
-  dirs.emplace_back(MANNEQUIN_SOURCE_TREE);
+  add(MANNEQUIN_SOURCE_TREE);
 #endif
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
     fs::path d = exe.parent_path();
-    for (int up = 0; up < 3 && !d.empty(); ++up, d = d.parent_path()) dirs.push_back(d.string());
+    for (int up = 0; up < 3 && !d.empty(); ++up, d = d.parent_path()) add(d);
   }
   return dirs;
 }

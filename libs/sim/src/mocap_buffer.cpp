@@ -3,18 +3,18 @@
 namespace mannequin::sim {
 
 namespace {
-const BodyInput* findBody(const MocapInput& f, const std::string& name) {
-  for (const BodyInput& b : f.bodies)
+const mocap::Body* findBody(const mocap::Frame& f, const std::string& name) {
+  for (const mocap::Body& b : f.bodies)
     if (b.name == name) return &b;
   return nullptr;
 }
 }  // namespace
 
-bool MocapBuffer::add(const MocapInput& frame) {
+bool MocapBuffer::add(const mocap::Frame& frame) {
   if (!frames_.empty() && frame.stamp_ns <= frames_.back().stamp_ns) return false;
   frames_.push_back(frame);
   while (frames_.size() > 2 && frames_.back().stamp_ns - frames_.front().stamp_ns > window_ns_) frames_.pop_front();
-  for (const BodyInput& b : frame.bodies) {
+  for (const mocap::Body& b : frame.bodies) {
     if (!b.tracked) continue;
     bool found = false;
     for (LastTracked& l : last_tracked_)
@@ -41,18 +41,18 @@ BodySample MocapBuffer::sample(const std::string& body, std::int64_t t_ns) const
   std::size_t k = 0;
   while (k < frames_.size() && frames_[k].stamp_ns <= t_ns) ++k;
   if (k == frames_.size() || k == 0) {  // past the newest (or before the oldest): that frame
-    const MocapInput& f = k == 0 ? frames_.front() : frames_.back();
-    const BodyInput* b = findBody(f, body);
+    const mocap::Frame& f = k == 0 ? frames_.front() : frames_.back();
+    const mocap::Body* b = findBody(f, body);
     if (b != nullptr && b->tracked) {
       out.pose = b->pose;
       out.tracked = true;
     }
     return out;
   }
-  const MocapInput& f0 = frames_[k - 1];
-  const MocapInput& f1 = frames_[k];
-  const BodyInput* b0 = findBody(f0, body);
-  const BodyInput* b1 = findBody(f1, body);
+  const mocap::Frame& f0 = frames_[k - 1];
+  const mocap::Frame& f1 = frames_[k];
+  const mocap::Body* b0 = findBody(f0, body);
+  const mocap::Body* b1 = findBody(f1, body);
   const bool t0 = b0 != nullptr && b0->tracked, t1 = b1 != nullptr && b1->tracked;
   if (t0 && t1) {
     const double gamma = static_cast<double>(t_ns - f0.stamp_ns) / static_cast<double>(f1.stamp_ns - f0.stamp_ns);

@@ -92,14 +92,14 @@ std::int64_t World::captureTimeNs() const {
          static_cast<std::int64_t>(std::llround(config_.interpolation_delay * 1e9));
 }
 
-void World::calibrate(Mannequin& m, const MocapInput& frame) {
-  auto find = [&](const std::string& body) -> const BodyInput* {
-    for (const BodyInput& b : frame.bodies)
+void World::calibrate(Mannequin& m, const mocap::Frame& frame) {
+  auto find = [&](const std::string& body) -> const mocap::Body* {
+    for (const mocap::Body& b : frame.bodies)
       if (b.name == body) return &b;
     return nullptr;
   };
   for (const auto& st : m.frames) {
-    const BodyInput* b = find(st.body);
+    const mocap::Body* b = find(st.body);
     if (b == nullptr || !b->tracked) return;  // not every body visible: wait
   }
   if (config_.calibration_needs_flag && !frame.calibration_pose) return;
@@ -108,7 +108,7 @@ void World::calibrate(Mannequin& m, const MocapInput& frame) {
   if (m.root_frame >= 0)
     for (const auto& st : m.frames)
       if (st.frame_index == m.root_frame) {
-        const BodyInput* b = find(st.body);
+        const mocap::Body* b = find(st.body);
         qc(0) = b->pose.p.x();
         qc(1) = b->pose.p.y();
         // heading of the body's x axis projected on the floor
@@ -138,7 +138,7 @@ void World::calibrate(Mannequin& m, const MocapInput& frame) {
   std::fill(m.have_previous.begin(), m.have_previous.end(), false);
   const skeleton::Data& d = m.stepper->data();
   for (auto& st : m.frames) {
-    const BodyInput* b = find(st.body);
+    const mocap::Body* b = find(st.body);
     st.offset = b->pose.inverse() * d.oMf[st.frame_index];
     st.target = st.actual = d.oMf[st.frame_index];
   }
@@ -146,7 +146,7 @@ void World::calibrate(Mannequin& m, const MocapInput& frame) {
   m.calibrated = true;
 }
 
-void World::addMocap(const MocapInput& frame) {
+void World::addMocap(const mocap::Frame& frame) {
   if (!buffer_.add(frame)) return;
   for (auto& m : mannequins_)
     if (!m->calibrated) calibrate(*m, frame);

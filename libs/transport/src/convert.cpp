@@ -34,6 +34,41 @@ math::SE3 fromMsg(const v1::Pose& pose) {
   return out;
 }
 
+void toMsg(const mocap::Frame& f, const std::string& source_kind, v1::MocapFrame& out) {
+  out.Clear();
+  out.mutable_header()->set_stamp_ns(f.stamp_ns);
+  out.set_frame_number(f.frame_number);
+  out.set_calibration_pose(f.calibration_pose);
+  out.set_source_kind(source_kind);
+  for (const mocap::Body& b : f.bodies) {
+    v1::RigidBody* m = out.add_bodies();
+    m->set_name(b.name);
+    m->set_id(b.id);
+    m->set_tracked(b.tracked);
+    m->set_quality(b.quality);
+    toMsg(b.pose, *m->mutable_pose());
+  }
+}
+
+mocap::Frame fromMsg(const v1::MocapFrame& msg) {
+  mocap::Frame f;
+  f.stamp_ns = msg.header().stamp_ns();
+  f.sequence = msg.header().sequence();
+  f.send_time_ns = msg.header().send_time_ns();
+  f.frame_number = msg.frame_number();
+  f.calibration_pose = msg.calibration_pose();
+  f.bodies.reserve(static_cast<std::size_t>(msg.bodies_size()));
+  for (const v1::RigidBody& b : msg.bodies()) {
+    mocap::Body& o = f.bodies.emplace_back();
+    o.name = b.name();
+    o.id = b.id();
+    o.tracked = b.tracked();
+    o.quality = b.quality();
+    o.pose = fromMsg(b.pose());
+  }
+  return f;
+}
+
 std::string checkPose(const v1::Pose& pose, double tolerance) {
   const auto& p = pose.position();
   if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z())) return "position is not finite";

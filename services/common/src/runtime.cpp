@@ -1,50 +1,72 @@
 #include "mannequin/service/runtime.hpp"
 
-#include <spdlog/spdlog.h>
-
-#include <csignal>
-#include <stdexcept>
+#include "mannequin/core/clock.hpp"
+#include "mannequin/core/main.hpp"
 
 namespace mannequin::service {
 
-void addCommonOptions(CLI::App& app, CommonOptions& o, bool config_required) {
-  auto* c = app.add_option("--config", o.config, "service config (YAML)")->check(CLI::ExistingFile);
-  if (config_required) c->required();
+void addCommonOptions(CLI::App& app, CommonOptions& o) {
+  app.add_option("--config", o.config, "service config (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--name", o.name, "instance name (message source, heartbeat name)");
   app.add_option("--publish", o.publish, "endpoint to bind (tcp://HOST:PORT, ipc://PATH); repeatable, overrides the config");
   app.add_option("--connect", o.connect, "publisher endpoint to connect to; repeatable, overrides the config");
   app.add_option("--duration", o.duration, "stop after this many seconds (0: until SIGINT/SIGTERM)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
-  app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error")->capture_default_str();
+  app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error")->capture_default_str()->check(core::logLevelCheck());
   app.add_option("--heartbeat-period", o.heartbeat_period, "seconds between heartbeats")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 60.0));
 }
 
-void setupLogging(const std::string& level) {
-  const auto l = spdlog::level::from_str(level);
-  if (l == spdlog::level::off && level != "off") throw std::invalid_argument("unknown log level '" + level + "'");
-  spdlog::set_level(l);
-  spdlog::set_pattern("%^%l%$ %v");
+Cli::Cli(std::string description) : app(std::move(description)) { addCommonOptions(app, options); }
+
+int Cli::run(int argc, char** argv, const std::function<int(const std::atomic<bool>& stop)>& body) {
+  return core::runMain(app, argc, argv, [&] {
+    core::setupLogging(options.log_level);
+    return body(core::installStopSignals());
+  });
 }
 
-namespace {
-std::atomic<bool>& stopFlag() {
-  static std::atomic<bool> flag{false};
-  return flag;
+core::ConfigNode loadConfig(const CommonOptions& o, const std::function<void(YAML::Node&)>& overrides) {
+  core::ConfigNode loaded = core::ConfigNode::load(o.config);  // syntax errors with their line
+  if (!overrides) return loaded;
+  YAML::Node raw = YAML::Clone(YAML::LoadFile(o.config));
+  overrides(raw);
+  return core::ConfigNode(raw, o.config);
 }
-extern "C" void onStopSignal(int) { stopFlag().store(true); }
-}  // namespace
 
-const std::atomic<bool>& installStopSignals() {
-  struct sigaction sa {};
-  sa.sa_handler = onStopSignal;
-  sigemptyset(&sa.sa_mask);
-  sigaction(SIGINT, &sa, nullptr);
-  sigaction(SIGTERM, &sa, nullptr);
-  std::signal(SIGPIPE, SIG_IGN);
-  return stopFlag();
+Endpoints resolveEndpoints(const CommonOptions& o, const core::ConfigNode& config, const std::string& default_name) {
+  Endpoints e;
+  e.name = o.name.empty() ? config.get("name", default_name) : o.name;
+  e.publish = o.publish;
+  if (e.publish.empty() && config.has("publish")) e.publish = config["publish"].strings();
+  if (e.publish.empty()) throw core::ConfigError(o.config + ": no publish endpoint (config 'publish' or --publish)");
+  e.connect = o.connect;
+  if (e.connect.empty() && config.has("connect")) e.connect = config["connect"].strings();
+  return e;
+}
+
+ServiceLoop::ServiceLoop(transport::HealthReporter& health, const std::atomic<bool>& stop, double duration_s)
+    : health_(health), stop_(stop), duration_s_(duration_s) {}
+
+bool ServiceLoop::stopping() const { return stop_.load() || (duration_s_ > 0 && elapsed() >= duration_s_); }
+
+double ServiceLoop::elapsed() const { return static_cast<double>(core::steadyNs() - start_ns_) * 1e-9; }
+
+int ServiceLoop::run(const std::function<bool()>& iteration, const std::function<void()>& on_heartbeat,
+                     const std::function<void()>& on_stop) {
+  start_ns_ = core::steadyNs();
+  health_.setState(v1::SERVICE_STATE_RUNNING);
+  health_.tick(true);
+  while (!stopping()) {
+    if (!iteration()) break;
+    if (health_.tick() && on_heartbeat) on_heartbeat();
+  }
+  if (on_stop) on_stop();
+  health_.setState(v1::SERVICE_STATE_STOPPING);
+  health_.tick(true);
+  return core::kExitOk;
 }
 
 }  // namespace mannequin::service

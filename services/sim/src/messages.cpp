@@ -8,23 +8,6 @@ namespace mannequin::simservice {
 
 using transport::toMsg;
 
-sim::MocapInput toInput(const v1::MocapFrame& f) {
-  sim::MocapInput in;
-  in.stamp_ns = f.header().stamp_ns();
-  in.sequence = f.header().sequence();
-  in.send_time_ns = f.header().send_time_ns();
-  in.frame_number = f.frame_number();
-  in.calibration_pose = f.calibration_pose();
-  for (const v1::RigidBody& b : f.bodies()) {
-    sim::BodyInput bi;
-    bi.name = b.name();
-    bi.tracked = b.tracked();
-    if (b.tracked()) bi.pose = transport::fromMsg(b.pose());
-    in.bodies.push_back(bi);
-  }
-  return in;
-}
-
 void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool stale, bool replay, v1::WorldState& out) {
   out.Clear();
   const double t = world.time();
@@ -34,7 +17,7 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
   out.set_mode(replay ? "replay" : "live");
   out.set_contacts_stale(stale);
   if (contacts != nullptr) out.set_contacts_step(contacts->step());
-  if (const sim::MocapInput* m = world.latestMocap()) {
+  if (const mocap::Frame* m = world.latestMocap()) {
     v1::FrameRef* r = out.mutable_mocap();
     r->set_sequence(m->sequence);
     r->set_stamp_ns(m->stamp_ns);

@@ -6,8 +6,10 @@
 #include <cmath>
 #include <deque>
 
+#include "mannequin/service/runtime.hpp"
 #include "mannequin/simservice/messages.hpp"
 #include "mannequin/transport/clock.hpp"
+#include "mannequin/transport/convert.hpp"
 #include "mannequin/transport/health.hpp"
 #include "mannequin/transport/validate.hpp"
 
@@ -57,7 +59,7 @@ struct SimService::Impl {
       pending.push_back(f);
       return;
     }
-    const sim::MocapInput in = toInput(f);
+    const mocap::Frame in = transport::fromMsg(f);
     world.addMocap(in);
     new_mocap = true;
     if (!world.anchored()) {
@@ -164,48 +166,41 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
                s.config.world_rate, s.world.numMannequins(),
                s.config.stepper == StepperKind::kController ? "controller" : "kinematic tracker", fmt::join(s.pub.boundEndpoints(), ", "),
                fmt::join(s.config.connect, ", "));
-  s.health.setState(v1::SERVICE_STATE_RUNNING);
-  s.health.tick(true);
-  const std::int64_t start = transport::steadyNs();
-  std::int64_t next = start;
-  while (!stop.load()) {
-    const std::int64_t now = transport::steadyNs();
-    if (duration > 0 && (now - start) * 1e-9 >= duration) break;
-    s.pub.poll();
-    if (s.config.mode == Mode::kReplay) {
-      s.sub.poll(milliseconds(20));
-      while (!s.pending.empty() && !stop.load()) {
-        const sim::MocapInput in = toInput(s.pending.front());
-        s.pending.pop_front();
-        s.world.addMocap(in);
-        s.new_mocap = true;
-        if (!s.world.anchored()) s.world.anchor(in.stamp_ns);
-        while (s.world.captureTimeNs() + s.step_ns <= in.stamp_ns && !stop.load()) s.stepOnce(stop);
-      }
-    } else {
-      if (now < next) {
-        s.sub.poll(microseconds((next - now) / 1000));
-        if (transport::steadyNs() < next) {
-          s.health.tick();
-          continue;
-        }
-      }
-      const std::int64_t late = transport::steadyNs() - next;
-      s.health.lateness(static_cast<double>(late) * 1e-9);
-      s.sub.poll(microseconds(0));
-      s.stepOnce(stop);
-      next += s.step_ns;
-      if (late > 10'000'000) {  // more than 10 ms behind: resynchronise instead of running a burst of steps
-        ++s.stats.overruns;
-        next = transport::steadyNs() + s.step_ns;
-      }
-    }
-    if (s.stats.steps % 64 == 0) s.updateHealth();
-    s.health.tick();
-  }
-  s.updateHealth();
-  s.health.setState(v1::SERVICE_STATE_STOPPING);
-  s.health.tick(true);
+  std::int64_t next = transport::steadyNs();
+  service::ServiceLoop(s.health, stop, duration)
+      .run(
+          [&] {
+            s.pub.poll();
+            if (s.config.mode == Mode::kReplay) {
+              s.sub.poll(milliseconds(20));
+              while (!s.pending.empty() && !stop.load()) {
+                const mocap::Frame in = transport::fromMsg(s.pending.front());
+                s.pending.pop_front();
+                s.world.addMocap(in);
+                s.new_mocap = true;
+                if (!s.world.anchored()) s.world.anchor(in.stamp_ns);
+                while (s.world.captureTimeNs() + s.step_ns <= in.stamp_ns && !stop.load()) s.stepOnce(stop);
+              }
+            } else {
+              const std::int64_t now = transport::steadyNs();
+              if (now < next) {
+                s.sub.poll(microseconds((next - now) / 1000));
+                if (transport::steadyNs() < next) return true;
+              }
+              const std::int64_t late = transport::steadyNs() - next;
+              s.health.lateness(static_cast<double>(late) * 1e-9);
+              s.sub.poll(microseconds(0));
+              s.stepOnce(stop);
+              next += s.step_ns;
+              if (late > 10'000'000) {  // more than 10 ms behind: resynchronise instead of running a burst of steps
+                ++s.stats.overruns;
+                next = transport::steadyNs() + s.step_ns;
+              }
+            }
+            if (s.stats.steps % 64 == 0) s.updateHealth();
+            return true;
+          },
+          {}, [&] { s.updateHealth(); });
   spdlog::info("{}: stopped after {} steps ({:.3f} s simulated), {} mocap frames, {} sim.world", s.config.name, s.stats.steps,
                s.world.time(), s.stats.mocap_frames, s.stats.worlds);
   return 0;

@@ -3,7 +3,7 @@
 /// \brief The answer of a collision query: contacts between pairs of bodies in range.
 ///
 /// Conventions (docs/collision.md):
-/// - a pair is (a, b) with body_a < body_b (body ids of the World, names from World::bodyName);
+/// - a pair is (a, b) with body_a < body_b (body ids of the CollisionWorld, names from CollisionWorld::bodyName);
 /// - `normal` is a unit vector in the WORLD frame pointing from a to b;
 /// - `point_a` / `point_b` are the witness points, each in ITS BODY's local frame (scene body
 ///   frame, or the joint frame of a mannequin segment = skeleton::Data::oMi[segment.joint]), so
@@ -40,7 +40,7 @@ struct QueryStats {
   int triangles_tested = 0;  ///< mesh triangles reached by the BVH traversal
 };
 
-/// A preallocated set of contacts; World::query clears and refills it (keeping its capacity).
+/// A preallocated set of contacts; CollisionWorld::query clears and refills it (keeping its capacity).
 struct ContactSet {
   std::uint64_t step = 0;        ///< the simulation step the query was for
   std::vector<Contact> contacts; ///< sorted by (body_a, body_b, shape_a, shape_b, feature, point order)

@@ -16,7 +16,7 @@
 ///    4 points for face contacts (box on plane: 4 corners; capsule lying on a face: 2 ends);
 /// 4. sort by (body_a, body_b, shape_a, shape_b, feature): the same input gives the same bytes.
 ///
-/// Not thread-safe; one World per thread. query() does not allocate once its buffers have grown.
+/// Not thread-safe; one CollisionWorld per thread. query() does not allocate once its buffers have grown.
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -56,17 +56,17 @@ struct MannequinOptions {
 /// Kinds of bodies.
 enum class BodyKind { kStatic, kMovable, kSegment };
 
-class World {
+class CollisionWorld {
  public:
-  explicit World(const WorldOptions& options = {});
-  ~World();
-  World(World&&) noexcept;
-  World& operator=(World&&) noexcept;
-  World(const World&) = delete;
-  World& operator=(const World&) = delete;
+  explicit CollisionWorld(const WorldOptions& options = {});
+  ~CollisionWorld();
+  CollisionWorld(CollisionWorld&&) noexcept;
+  CollisionWorld& operator=(CollisionWorld&&) noexcept;
+  CollisionWorld(const CollisionWorld&) = delete;
+  CollisionWorld& operator=(const CollisionWorld&) = delete;
 
   /// Adds every body of a scene as "scene/<name>"; a scene's activation distance, if set, replaces
-  /// the World's. Call before the first query. \throws std::invalid_argument on a duplicate name.
+  /// the CollisionWorld's. Call before the first query. \throws std::invalid_argument on a duplicate name.
   void addScene(const SceneSpec& scene);
 
   /// Adds one body. \throws std::invalid_argument on a duplicate name, no shape, a negative or

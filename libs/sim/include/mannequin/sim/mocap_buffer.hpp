@@ -9,25 +9,9 @@
 #include <vector>
 
 #include "mannequin/math/se3.hpp"
+#include "mannequin/mocap/frame.hpp"
 
 namespace mannequin::sim {
-
-/// One body of a mocap frame (room frame, z up, m).
-struct BodyInput {
-  std::string name;
-  math::SE3 pose;
-  bool tracked = true;
-};
-
-/// One mocap frame as the World sees it (decoded from mocap.frame by the service).
-struct MocapInput {
-  std::int64_t stamp_ns = 0;        ///< capture time
-  std::uint64_t sequence = 0;       ///< Header.sequence
-  std::int64_t send_time_ns = 0;    ///< Header.send_time_ns
-  std::uint64_t frame_number = 0;
-  bool calibration_pose = false;
-  std::vector<BodyInput> bodies;
-};
 
 /// A body's pose at a time, and whether it is tracked there.
 struct BodySample {
@@ -42,11 +26,11 @@ class MocapBuffer {
   /// Keeps frames of the last `window_s` seconds of capture time.
   explicit MocapBuffer(double window_s = 1.0) : window_ns_(static_cast<std::int64_t>(window_s * 1e9)) {}
   /// Adds a frame. Frames whose stamp is not after the newest are ignored (returns false).
-  bool add(const MocapInput& frame);
+  bool add(const mocap::Frame& frame);
   /// The pose of `body` at capture time t_ns: interpolated between the frames around t when tracked
   /// in both, the tracked one of the two otherwise, the newest frame's (or last tracked) past the end.
   BodySample sample(const std::string& body, std::int64_t t_ns) const;
-  const MocapInput* newest() const { return frames_.empty() ? nullptr : &frames_.back(); }
+  const mocap::Frame* newest() const { return frames_.empty() ? nullptr : &frames_.back(); }
   std::size_t size() const { return frames_.size(); }
   void clear() { frames_.clear(); last_tracked_.clear(); }
 
@@ -57,7 +41,7 @@ class MocapBuffer {
     std::int64_t stamp_ns = 0;
   };
   std::int64_t window_ns_;
-  std::deque<MocapInput> frames_;
+  std::deque<mocap::Frame> frames_;
   std::vector<LastTracked> last_tracked_;
 };
 

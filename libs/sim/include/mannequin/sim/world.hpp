@@ -93,7 +93,7 @@ class World {
   ~World();
 
   /// Adds a mocap frame (ignored if not newer than the last). Calibrates mannequins when possible.
-  void addMocap(const MocapInput& frame);
+  void addMocap(const mocap::Frame& frame);
   /// Ties the World clock to the capture clock: now, capture time is `capture_ns`.
   void anchor(std::int64_t capture_ns);
   bool anchored() const { return anchored_; }
@@ -116,12 +116,12 @@ class World {
   const Stepper& stepper(int m) const;
   const std::vector<ControlFrameStatus>& controlFrames(int m) const;
   /// The newest mocap frame added (nullptr before any).
-  const MocapInput* latestMocap() const { return buffer_.newest(); }
+  const mocap::Frame* latestMocap() const { return buffer_.newest(); }
   std::uint64_t failedSteps() const { return failed_steps_; }
 
  private:
   struct Mannequin;
-  void calibrate(Mannequin& m, const MocapInput& frame);
+  void calibrate(Mannequin& m, const mocap::Frame& frame);
   math::Vector6 targetTwist(Mannequin& m, std::size_t i, double dt) const;
   std::vector<std::unique_ptr<Mannequin>> mannequins_;
   SimConfig config_;

@@ -1,19 +1,25 @@
 #pragma once
 /// \file runtime.hpp
-/// \brief What every service main shares: the common command-line options, stop on SIGINT/SIGTERM,
-/// logging set-up.
+/// \brief The service kit: the options every service accepts, its config with command-line overrides,
+/// its endpoints, runService (core::runMain + logging level + stop signals) and the one service loop.
 #include <atomic>
+#include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
 #include <CLI/CLI.hpp>
+#include <yaml-cpp/yaml.h>
+
+#include "mannequin/core/config.hpp"
+#include "mannequin/transport/health.hpp"
 
 namespace mannequin::service {
 
 /// Options every service accepts (the launcher passes --name, --publish, --connect).
 struct CommonOptions {
   std::string config;                 ///< --config FILE (YAML)
-  std::string name;                   ///< --name: Header.source and heartbeat name (default: the service)
+  std::string name;                   ///< --name: Header.source and heartbeat name (default: the config's, else the service)
   std::vector<std::string> publish;   ///< --publish ENDPOINT (repeatable): overrides the config's `publish`
   std::vector<std::string> connect;   ///< --connect ENDPOINT (repeatable): overrides the config's `connect`
   double duration = 0.0;              ///< --duration S: stop by itself after S seconds (0 = run until a signal)
@@ -21,15 +27,52 @@ struct CommonOptions {
   double heartbeat_period = 0.5;      ///< --heartbeat-period S
 };
 
-/// Adds the common options to a CLI11 app.
-void addCommonOptions(CLI::App& app, CommonOptions& options, bool config_required);
+/// Adds the common options to a CLI11 app (--config is required).
+void addCommonOptions(CLI::App& app, CommonOptions& options);
 
-/// Sets the spdlog level and a pattern without the date (the launcher prefixes and timestamps lines).
-/// \throws std::invalid_argument for an unknown level.
-void setupLogging(const std::string& level);
+/// A service's command line: the CLI11 app with the common options (add the service's own to `app`).
+struct Cli {
+  explicit Cli(std::string description);
+  CLI::App app;
+  CommonOptions options;
+  /// core::runMain for a service: parses, sets the --log-level, installs the stop signals, then runs
+  /// body(stop). Exit codes as core::runMain (0, 1 when the body throws, 2 on a bad command line).
+  int run(int argc, char** argv, const std::function<int(const std::atomic<bool>& stop)>& body);
+};
 
-/// Installs SIGINT/SIGTERM handlers that set the returned flag (the one process-wide state a signal
-/// handler needs). SIGPIPE is ignored.
-const std::atomic<bool>& installStopSignals();
+/// Loads --config (FILE:LINE on syntax errors) and applies the command-line overrides to the tree.
+/// \throws core::ConfigError.
+core::ConfigNode loadConfig(const CommonOptions& options, const std::function<void(YAML::Node&)>& overrides = {});
+
+/// Who a service is on the network: the command line wins over the config (`name`, `publish`, `connect`).
+struct Endpoints {
+  std::string name;
+  std::vector<std::string> publish;
+  std::vector<std::string> connect;
+};
+/// \throws core::ConfigError when there is no endpoint to publish on.
+Endpoints resolveEndpoints(const CommonOptions& options, const core::ConfigNode& config, const std::string& default_name);
+
+/// The loop of every service: health RUNNING and a heartbeat at start; then, until a stop signal,
+/// `duration` seconds (0: no limit) or the iteration returning false, one iteration (which waits on its
+/// own sockets or source, up to its poll period) and a heartbeat when its period is due; at the end
+/// STOPPING and a last heartbeat.
+class ServiceLoop {
+ public:
+  ServiceLoop(transport::HealthReporter& health, const std::atomic<bool>& stop, double duration_s = 0.0);
+  /// `on_heartbeat` runs after every heartbeat published (per-period statistics restart), `on_stop`
+  /// once before the STOPPING heartbeat (final statistics). Returns core::kExitOk.
+  int run(const std::function<bool()>& iteration, const std::function<void()>& on_heartbeat = {},
+          const std::function<void()>& on_stop = {});
+  /// True once a stop signal came or the duration is over (for waits inside an iteration).
+  bool stopping() const;
+  double elapsed() const;  ///< s since run() started
+
+ private:
+  transport::HealthReporter& health_;
+  const std::atomic<bool>& stop_;
+  double duration_s_;
+  std::int64_t start_ns_ = 0;
+};
 
 }  // namespace mannequin::service

@@ -1,6 +1,6 @@
 #pragma once
 /// \file messages.hpp
-/// \brief Conversions between the World and the mannequin.v1 messages.
+/// \brief The World's state and collision query as mannequin.v1 messages (mocap frames: transport/convert.hpp).
 #include <mannequin/v1/collision.pb.h>
 #include <mannequin/v1/mocap.pb.h>
 #include <mannequin/v1/world.pb.h>
@@ -8,9 +8,6 @@
 #include "mannequin/sim/world.hpp"
 
 namespace mannequin::simservice {
-
-/// MocapFrame → World input (untracked bodies keep tracked = false).
-sim::MocapInput toInput(const v1::MocapFrame& frame);
 
 /// The World's state (header.stamp_ns = simulation time; the publisher fills the rest). `contacts`
 /// (may be null): the contact set in use, with `stale` when it is older than its deadline.

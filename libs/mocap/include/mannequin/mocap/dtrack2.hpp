@@ -33,7 +33,7 @@ struct DTrackBody {
 };
 
 /// One parsed datagram.
-struct DTrackFrame {
+struct DTrackDatagram {
   std::optional<std::uint32_t> frame_counter;   ///< "fr"
   std::optional<double> timestamp;              ///< "ts", s
   std::optional<int> calibrated_bodies;         ///< "6dcal"
@@ -43,7 +43,7 @@ struct DTrackFrame {
 /// Parses one datagram. Returns "" on success, else "line N: what is wrong" (then `out` is unusable).
 /// Rejects non-finite numbers, non-orthonormal rotation matrices (|RᵀR − I| > 1e-3), negative or
 /// duplicate ids, counts that do not match the blocks, and datagrams without an "fr" line.
-std::string parseDTrack(std::string_view datagram, DTrackFrame& out);
+std::string parseDTrack(std::string_view datagram, DTrackDatagram& out);
 
 struct DTrackOptions {
   std::string bind_address = "127.0.0.1";
@@ -55,22 +55,22 @@ struct DTrackOptions {
   math::Matrix3 room_rotation = math::Matrix3::Identity();
 };
 
-/// Receives DTrack2 datagrams on a UDP socket (Asio) and turns them into samples. A configured body
+/// Receives DTrack2 datagrams on a UDP socket (Asio) and turns them into frames. A configured body
 /// that is absent from a frame is reported untracked with its last tracked pose.
 class DTrackSource final : public Source {
  public:
   /// \throws std::runtime_error if the socket cannot be bound.
   explicit DTrackSource(DTrackOptions options);
   ~DTrackSource() override;
-  std::optional<Sample> next(std::chrono::microseconds timeout) override;
+  std::optional<Frame> next(std::chrono::microseconds timeout) override;
   bool finished() const override { return false; }
   std::string kind() const override { return "dtrack2"; }
   std::string describe() const override;
   /// The UDP port actually bound.
   int port() const;
   std::uint64_t malformedDatagrams() const { return malformed_; }
-  /// The sample of a parsed frame (updates the last known poses).
-  Sample toSample(const DTrackFrame& frame, std::int64_t receive_ns);
+  /// The Frame of a parsed datagram (updates the last known poses).
+  Frame toFrame(const DTrackDatagram& frame, std::int64_t receive_ns);
 
  private:
   struct Impl;

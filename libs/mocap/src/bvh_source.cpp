@@ -5,7 +5,7 @@
 #include <cmath>
 #include <stdexcept>
 
-#include "mannequin/transport/clock.hpp"
+#include "mannequin/core/clock.hpp"
 
 namespace mannequin::mocap {
 
@@ -48,10 +48,10 @@ std::string BvhSource::describe() const {
                      joints_.size());
 }
 
-Sample BvhSource::sampleAt(int frame, std::uint64_t loops) const {
+Frame BvhSource::frameAt(int frame, std::uint64_t loops) const {
   const math::Matrix3 A = bvhToRoom();
   skeleton::bvhForwardKinematics(bvh_, skeleton::bvhFrame(bvh_, frame), world_, bvh_.unit_scale_to_m);
-  Sample s;
+  Frame s;
   const std::uint64_t span = static_cast<std::uint64_t>(last_ - first_ + 1);
   const std::uint64_t index = loops * span + static_cast<std::uint64_t>(frame - first_);
   s.frame_number = index;
@@ -68,19 +68,19 @@ Sample BvhSource::sampleAt(int frame, std::uint64_t loops) const {
   return s;
 }
 
-std::optional<Sample> BvhSource::next(std::chrono::microseconds timeout) {
+std::optional<Frame> BvhSource::next(std::chrono::microseconds timeout) {
   if (finished_) return std::nullopt;
   const std::uint64_t span = static_cast<std::uint64_t>(last_ - first_ + 1);
   const std::uint64_t index = loops_ * span + static_cast<std::uint64_t>(frame_ - first_);
   if (options_.paced) {
     if (!started_) {
       started_ = true;
-      start_ns_ = transport::steadyNs();
+      start_ns_ = core::steadyNs();
     }
     const auto due = start_ns_ + static_cast<std::int64_t>(static_cast<double>(index) * bvh_.frame_time / options_.rate * 1e9);
     if (!sleepUntil(due, timeout)) return std::nullopt;
   }
-  Sample s = sampleAt(frame_, loops_);
+  Frame s = frameAt(frame_, loops_);
   if (++frame_ > last_) {
     if (options_.loop) {
       frame_ = first_;

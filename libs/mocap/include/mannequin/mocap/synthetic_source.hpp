@@ -37,12 +37,12 @@ class SyntheticSource final : public Source {
  public:
   /// \throws std::invalid_argument for a rate <= 0 or no bodies.
   explicit SyntheticSource(SyntheticOptions options);
-  std::optional<Sample> next(std::chrono::microseconds timeout) override;
+  std::optional<Frame> next(std::chrono::microseconds timeout) override;
   bool finished() const override { return finished_; }
   std::string kind() const override { return "synthetic"; }
   std::string describe() const override;
-  /// The sample at frame k (time k / rate_hz).
-  Sample sampleAt(std::uint64_t k) const;
+  /// The frame at index k (time k / rate_hz).
+  Frame frameAt(std::uint64_t k) const;
 
  private:
   SyntheticOptions options_;

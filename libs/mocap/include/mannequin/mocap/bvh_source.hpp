@@ -29,13 +29,13 @@ class BvhSource final : public Source {
  public:
   /// \throws skeleton::BvhError for a bad file, std::invalid_argument for unknown joints or a bad range.
   explicit BvhSource(BvhSourceOptions options);
-  std::optional<Sample> next(std::chrono::microseconds timeout) override;
+  std::optional<Frame> next(std::chrono::microseconds timeout) override;
   bool finished() const override { return finished_; }
   std::string kind() const override { return "bvh"; }
   std::string describe() const override;
   const skeleton::Bvh& bvh() const { return bvh_; }
-  /// The sample of file frame `frame` played `loops` times before (no pacing, no side effect).
-  Sample sampleAt(int frame, std::uint64_t loops) const;
+  /// The frame of file frame `frame` played `loops` times before (no pacing, no side effect).
+  Frame frameAt(int frame, std::uint64_t loops) const;
 
  private:
   BvhSourceOptions options_;

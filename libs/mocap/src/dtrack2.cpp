@@ -10,7 +10,7 @@
 
 #include <spdlog/spdlog.h>
 
-#include "mannequin/transport/clock.hpp"
+#include "mannequin/core/clock.hpp"
 
 namespace mannequin::mocap {
 
@@ -65,7 +65,7 @@ struct Cursor {
   }
 };
 
-std::string parse6d(Cursor& c, DTrackFrame& out) {
+std::string parse6d(Cursor& c, DTrackDatagram& out) {
   long long n = 0;
   if (!c.integer(n) || n < 0 || n > 10000) return "6d: expected the number of bodies";
   std::vector<double> b;
@@ -98,8 +98,8 @@ std::string parse6d(Cursor& c, DTrackFrame& out) {
 
 }  // namespace
 
-std::string parseDTrack(std::string_view datagram, DTrackFrame& out) {
-  out = DTrackFrame{};
+std::string parseDTrack(std::string_view datagram, DTrackDatagram& out) {
+  out = DTrackDatagram{};
   int line_no = 0;
   std::size_t pos = 0;
   bool any_6d = false;
@@ -179,8 +179,8 @@ std::string DTrackSource::describe() const {
   return fmt::format("ART DTrack2 UDP ASCII on {}:{} ({} bodies)", options_.bind_address, port(), options_.bodies.size());
 }
 
-Sample DTrackSource::toSample(const DTrackFrame& frame, std::int64_t receive_ns) {
-  Sample s;
+Frame DTrackSource::toFrame(const DTrackDatagram& frame, std::int64_t receive_ns) {
+  Frame s;
   s.frame_number = frame.frame_counter.value_or(0);
   s.stamp_ns = frame.timestamp ? static_cast<std::int64_t>(std::llround(*frame.timestamp * 1e9)) : receive_ns;
   for (Body& b : last_) {
@@ -198,16 +198,16 @@ Sample DTrackSource::toSample(const DTrackFrame& frame, std::int64_t receive_ns)
   return s;
 }
 
-std::optional<Sample> DTrackSource::next(std::chrono::microseconds timeout) {
-  const std::int64_t until = transport::steadyNs() + timeout.count() * 1000;
+std::optional<Frame> DTrackSource::next(std::chrono::microseconds timeout) {
+  const std::int64_t until = core::steadyNs() + timeout.count() * 1000;
   for (;;) {
     asio::error_code ec;
     asio::ip::udp::endpoint from;
     const std::size_t n = impl_->socket.receive_from(asio::buffer(impl_->buffer), from, 0, ec);
     if (!ec) {
-      DTrackFrame frame;
+      DTrackDatagram frame;
       const std::string why = parseDTrack(std::string_view(impl_->buffer.data(), n), frame);
-      if (why.empty()) return toSample(frame, transport::wallNs());
+      if (why.empty()) return toFrame(frame, core::wallNs());
       ++malformed_;
       if (malformed_ < 10 || malformed_ % 1000 == 0)
         spdlog::warn("dtrack2: malformed datagram from {} ({} bytes, {} so far): {}", from.address().to_string(), n,
@@ -216,7 +216,7 @@ std::optional<Sample> DTrackSource::next(std::chrono::microseconds timeout) {
     }
     if (ec != asio::error::would_block && ec != asio::error::try_again)
       spdlog::warn("dtrack2: receive failed: {}", ec.message());
-    const std::int64_t left = until - transport::steadyNs();
+    const std::int64_t left = until - core::steadyNs();
     if (left <= 0) return std::nullopt;
     pollfd p{impl_->socket.native_handle(), POLLIN, 0};
     ::poll(&p, 1, static_cast<int>(std::max<std::int64_t>(1, left / 1000000)));

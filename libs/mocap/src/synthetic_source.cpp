@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "mannequin/math/so3.hpp"
-#include "mannequin/transport/clock.hpp"
+#include "mannequin/core/clock.hpp"
 
 namespace mannequin::mocap {
 
@@ -25,9 +25,9 @@ std::string SyntheticSource::describe() const {
                      options_.duration > 0 ? fmt::format(" for {} s", options_.duration) : std::string());
 }
 
-Sample SyntheticSource::sampleAt(std::uint64_t k) const {
+Frame SyntheticSource::frameAt(std::uint64_t k) const {
   const double t = static_cast<double>(k) / options_.rate_hz;
-  Sample s;
+  Frame s;
   s.frame_number = k;
   s.stamp_ns = static_cast<std::int64_t>(std::llround(t * 1e9));
   s.calibration_pose = k == 0;
@@ -47,7 +47,7 @@ Sample SyntheticSource::sampleAt(std::uint64_t k) const {
   return s;
 }
 
-std::optional<Sample> SyntheticSource::next(std::chrono::microseconds timeout) {
+std::optional<Frame> SyntheticSource::next(std::chrono::microseconds timeout) {
   if (finished_) return std::nullopt;
   if (options_.duration > 0 && static_cast<double>(k_) / options_.rate_hz > options_.duration) {
     finished_ = true;
@@ -56,12 +56,12 @@ std::optional<Sample> SyntheticSource::next(std::chrono::microseconds timeout) {
   if (options_.paced) {
     if (!started_) {
       started_ = true;
-      start_ns_ = transport::steadyNs();
+      start_ns_ = core::steadyNs();
     }
     const auto due = start_ns_ + static_cast<std::int64_t>(static_cast<double>(k_) / options_.rate_hz * 1e9);
     if (!sleepUntil(due, timeout)) return std::nullopt;
   }
-  return sampleAt(k_++);
+  return frameAt(k_++);
 }
 
 }  // namespace mannequin::mocap

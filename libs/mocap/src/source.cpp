@@ -3,20 +3,20 @@
 #include <cmath>
 #include <thread>
 
+#include "mannequin/core/paths.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/mocap/bvh_source.hpp"
 #include "mannequin/mocap/dtrack2.hpp"
 #include "mannequin/mocap/synthetic_source.hpp"
 #include "mannequin/skeleton/bvh_drive.hpp"
-#include "mannequin/transport/clock.hpp"
-#include "mannequin/transport/convert.hpp"
+#include "mannequin/core/clock.hpp"
 
 namespace mannequin::mocap {
 
 using core::ConfigNode;
 
 bool sleepUntil(std::int64_t deadline_ns, std::chrono::microseconds max_wait) {
-  const std::int64_t now = transport::steadyNs();
+  const std::int64_t now = core::steadyNs();
   const std::int64_t wait = deadline_ns - now;
   if (wait <= 0) return true;
   if (wait > max_wait.count() * 1000) {
@@ -27,35 +27,22 @@ bool sleepUntil(std::int64_t deadline_ns, std::chrono::microseconds max_wait) {
   return true;
 }
 
-v1::MocapFrame toMessage(const Sample& s, const std::string& kind) {
-  v1::MocapFrame f;
-  f.mutable_header()->set_stamp_ns(s.stamp_ns);
-  f.set_frame_number(s.frame_number);
-  f.set_calibration_pose(s.calibration_pose);
-  f.set_source_kind(kind);
-  for (const Body& b : s.bodies) {
-    v1::RigidBody* m = f.add_bodies();
-    m->set_name(b.name);
-    m->set_id(b.id);
-    m->set_tracked(b.tracked);
-    m->set_quality(b.quality);
-    transport::toMsg(b.pose, *m->mutable_pose());
-  }
-  return f;
-}
-
 namespace {
 
 std::unique_ptr<Source> makeBvh(const ConfigNode& c) {
   c.allowOnly({"file", "map", "unit_scale_to_m", "bodies", "rate", "loop", "start_frame", "end_frame", "paced",
                "mark_calibration"});
   BvhSourceOptions o;
-  o.file = c["file"].str();
+  try {
+    o.file = core::findData(c["file"].str());
+  } catch (const core::ConfigError& e) {
+    c["file"].fail(e.what());
+  }
   skeleton::BvhDriveMap map;
   const auto map_node = c.find("map");
   if (map_node) {
     try {
-      map = skeleton::loadBvhDriveMap(map_node->str());
+      map = skeleton::loadBvhDriveMap(core::findData(map_node->str()));
     } catch (const std::exception& e) {
       map_node->fail(e.what());
     }
