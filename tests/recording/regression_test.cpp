@@ -177,7 +177,7 @@ mannequins:
       }
       if (!done) std::this_thread::sleep_for(100ms);
     }
-    ASSERT_TRUE(done) << "within 60 s no heartbeat of the sim recorded in " << out << " counts the " << frames
+    ASSERT_TRUE(done.has_value()) << "within 60 s no heartbeat of the sim recorded in " << out << " counts the " << frames
                       << " mocap frames replayed (at most " << delivered << ")\n"
                       << log("sim-" + tag) << log("record-" + tag);
     std::uint64_t published = 0;

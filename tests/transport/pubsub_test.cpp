@@ -127,7 +127,9 @@ TEST(PubSub, LatestOnlyDeliversTheNewestStateOfABacklog) {
       ASSERT_EQ(got.size() - delivered_before, drained > 0 ? 1u : 0u) << "one state per poll, of " << drained << " drained";
       EXPECT_EQ(after.superseded - before.superseded, drained > 0 ? drained - 1 : 0u);
       EXPECT_EQ(after.delivered - before.delivered, drained > 0 ? 1u : 0u);
-      if (drained > 0) EXPECT_EQ(got.back().step(), step - 50 + (after.received - start.received)) << "the newest drained";
+      if (drained > 0) {
+        EXPECT_EQ(got.back().step(), step - 50 + (after.received - start.received)) << "the newest drained";
+      }
       backlog = backlog || drained > 1;
     }
     ASSERT_FALSE(got.empty());
