@@ -1,6 +1,6 @@
 // The supervisor never signals a pid ≤ 0 (kill(-1) is every process, kill(0) our own group, kill(-(-1))
-// init): every kill() of this executable is recorded by an interposed kill() (then forwarded to the
-// kernel), and the services are stopped in every state where their pid is -1 — finished, failed,
+// init): every kill() of this executable is recorded by an interposed kill() (forwarded to the kernel unless it
+// names -1, 0 or 1), and the services are stopped in every state where their pid is -1 — finished, failed,
 // never started (exec failed), waiting for a restart — next to one that ignores SIGTERM (SIGKILL path).
 #include <gtest/gtest.h>
 #include <signal.h>
