@@ -16,6 +16,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "mannequin/core/process.hpp"
 #include "mannequin/transport/clock.hpp"
 #include "mannequin/transport/subscriber.hpp"
 
@@ -41,6 +42,19 @@ std::string describeExit(int status) {
   if (WIFEXITED(status)) return fmt::format("exit {}", WEXITSTATUS(status));
   if (WIFSIGNALED(status)) return fmt::format("signal {} ({})", WTERMSIG(status), strsignal(WTERMSIG(status)));
   return "unknown";
+}
+
+// The process group of a service (it is its group leader, setpgid in start). The check that a pid ≤ 0
+// (a service not running) is never signalled is core::signalProcess's; kNoProcess (it exited since the
+// last reap) is fine, the next reap collects it.
+const char* signalServiceGroup(pid_t pid, int sig) {
+  switch (core::signalProcess(pid, sig, core::SignalTarget::kGroup)) {
+    case core::SignalResult::kSent:
+    case core::SignalResult::kNoProcess: return nullptr;
+    case core::SignalResult::kRefused: return "refused (not a running process)";
+    case core::SignalResult::kFailed: return std::strerror(errno);
+  }
+  return "?";
 }
 }  // namespace
 
@@ -69,6 +83,17 @@ Supervisor::Supervisor(Deployment deployment, SupervisorOptions options)
     impl_->name_width = std::max(impl_->name_width, s.name.size());
   }
   impl_->children.resize(deployment_.services.size());
+  snapshot_ = status_;
+}
+
+void Supervisor::publishSnapshot() {
+  std::lock_guard<std::mutex> lock(snapshot_mutex_);
+  snapshot_ = status_;
+}
+
+std::vector<ServiceStatus> Supervisor::status() const {
+  std::lock_guard<std::mutex> lock(snapshot_mutex_);
+  return snapshot_;
 }
 
 Supervisor::~Supervisor() {
@@ -274,6 +299,7 @@ int Supervisor::run(const std::atomic<bool>& stop) {
 
   const std::int64_t t0 = transport::steadyNs();
   for (std::size_t i = 0; i < deployment_.services.size(); ++i) start(i);
+  publishSnapshot();
   std::int64_t last_status = t0;
   while (!stop.load()) {
     if (options_.duration > 0 && secondsSince(t0) >= options_.duration) {
@@ -311,12 +337,13 @@ int Supervisor::run(const std::atomic<bool>& stop) {
       last_status = now;
       if (options_.tty) {
         clearStatus();
-        writeAll(options_.out, statusLine());
+        writeAll(options_.out, statusLineOf(status_));
         impl_->status_shown = true;
       } else {
-        writeAll(options_.out, fmt::format("{:<{}} | {}\n", "status", impl_->name_width, statusLine()));
+        writeAll(options_.out, fmt::format("{:<{}} | {}\n", "status", impl_->name_width, statusLineOf(status_)));
       }
     }
+    publishSnapshot();
   }
 
   // shutdown: SIGTERM in reverse order, then SIGKILL after the timeout; reap everything
@@ -327,8 +354,10 @@ int Supervisor::run(const std::atomic<bool>& stop) {
     if (st.state == ServiceState::kBackoff) st.state = ServiceState::kStopped;
     if (st.pid <= 0) continue;
     impl_->children[k].stopping = true;
-    kill(-st.pid, SIGTERM);
+    if (const char* error = signalServiceGroup(st.pid, SIGTERM))
+      launcherLine(fmt::format("{} (pid {}): SIGTERM {}", st.name, st.pid, error));
   }
+  publishSnapshot();
   const std::int64_t stop_start = transport::steadyNs();
   auto anyRunning = [&] {
     for (const auto& st : status_)
@@ -344,16 +373,19 @@ int Supervisor::run(const std::atomic<bool>& stop) {
       for (auto& st : status_)
         if (st.pid > 0) {
           launcherLine(fmt::format("{} did not stop within {} s: SIGKILL", st.name, deployment_.stop_timeout));
-          kill(-st.pid, SIGKILL);
+          if (const char* error = signalServiceGroup(st.pid, SIGKILL))
+            launcherLine(fmt::format("{} (pid {}): SIGKILL {}", st.name, st.pid, error));
           st.clean_exit = false;
         }
       killed = true;
     }
+    publishSnapshot();
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
   impl_->heartbeats->poll(std::chrono::microseconds(0));
   for (std::size_t i = 0; i < status_.size(); ++i) drain(i, true);
   std::filesystem::remove(deployment_.run_dir, ec);  // only if empty
+  publishSnapshot();
 
   int rc = 0;
   for (const auto& st : status_)
@@ -362,11 +394,13 @@ int Supervisor::run(const std::atomic<bool>& stop) {
 }
 
 
-std::string Supervisor::statusLine() const {
+std::string Supervisor::statusLine() const { return statusLineOf(status()); }
+
+std::string Supervisor::statusLineOf(const std::vector<ServiceStatus>& all) {
   int up = 0;
-  for (const auto& st : status_) up += st.state == ServiceState::kUp;
-  std::string line = fmt::format("{}/{} up", up, status_.size());
-  for (const auto& st : status_) {
+  for (const auto& st : all) up += st.state == ServiceState::kUp;
+  std::string line = fmt::format("{}/{} up", up, all.size());
+  for (const auto& st : all) {
     line += fmt::format(" | {} {}", st.name, st.state == ServiceState::kUp ? "" : std::string(toString(st.state)) + " ");
     if (!st.has_heartbeat) continue;
     const auto& hb = st.heartbeat;
@@ -381,8 +415,9 @@ std::string Supervisor::statusLine() const {
 }
 
 std::string Supervisor::summary() const {
+  const std::vector<ServiceStatus> all = status();
   std::string s = fmt::format("summary of deployment '{}' ({})\n", deployment_.name, deployment_.source);
-  for (const auto& st : status_) {
+  for (const auto& st : all) {
     s += fmt::format("  {:<{}} {:<10} starts {} restarts {} last {} heartbeats {}\n", st.name, impl_->name_width,
                      toString(st.state), st.starts, st.restarts, st.last_exit.empty() ? "-" : st.last_exit, st.heartbeats);
     if (!st.has_heartbeat) continue;
@@ -415,9 +450,10 @@ std::string Supervisor::summaryJson() const {
     return o + "\"";
   };
   auto num = [](double v) { return std::isfinite(v) ? fmt::format("{}", v) : std::string("null"); };
+  const std::vector<ServiceStatus> all = status();
   std::string s = fmt::format("{{\"deployment\": {}, \"services\": [", q(deployment_.name));
-  for (std::size_t i = 0; i < status_.size(); ++i) {
-    const auto& st = status_[i];
+  for (std::size_t i = 0; i < all.size(); ++i) {
+    const auto& st = all[i];
     std::string pids;
     for (pid_t p : st.pids) pids += (pids.empty() ? "" : ", ") + std::to_string(p);
     s += fmt::format("{}{{\"name\": {}, \"state\": {}, \"starts\": {}, \"restarts\": {}, \"last_exit\": {}, \"clean_exit\": {}, "

@@ -5,11 +5,14 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
+#include <thread>
 
+#include "mannequin/core/process.hpp"
 #include "mannequin/deploy/supervisor.hpp"
 
 using namespace mannequin::deploy;
@@ -21,7 +24,18 @@ std::string runDir() {
       .string();
 }
 
-bool processGone(pid_t pid) { return kill(pid, 0) != 0 && errno == ESRCH; }
+using mannequin::core::processGone;
+
+// Polls cond() (on status() snapshots) until it holds or `timeout` passes; false on the deadline.
+template <class Cond>
+bool waitFor(Cond cond, std::chrono::seconds timeout) {
+  const auto until = std::chrono::steady_clock::now() + timeout;
+  while (!cond()) {
+    if (std::chrono::steady_clock::now() >= until) return false;
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  return true;
+}
 }  // namespace
 
 TEST(Supervisor, RunsRestartsStopsAndLeavesNoProcess) {
@@ -57,7 +71,7 @@ services:
   free(buffer);
 
   EXPECT_EQ(rc, 1) << text;  // 'broken' failed permanently
-  const auto& st = sup.status();
+  const auto st = sup.status();
   ASSERT_EQ(st.size(), 2u);
   EXPECT_EQ(st[0].state, ServiceState::kStopped);
   EXPECT_EQ(st[0].last_exit, "exit 0");
@@ -108,19 +122,36 @@ services:
   Supervisor sup(d, o);
   std::atomic<bool> stop{false};
   std::thread killer([&] {
-    // wait for the first heartbeat, kill the service, wait for its second run, then stop
-    auto waitFor = [&](auto cond) {
-      for (int k = 0; k < 500 && !cond(); ++k) std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    };
-    waitFor([&] { return sup.status()[0].heartbeats > 0 && sup.status()[0].pid > 0; });
-    kill(sup.status()[0].pid, SIGKILL);
-    waitFor([&] { return sup.status()[0].starts == 2 && sup.status()[0].state == ServiceState::kUp; });
+    // wait for the first heartbeat, kill the service, wait for its second run, then stop (always: a
+    // wait that times out fails the test and still ends the run)
+    pid_t first = -1;
+    const bool up = waitFor(
+        [&] {
+          const ServiceStatus s = sup.status()[0];
+          first = s.pid;
+          return s.heartbeats > 0 && s.pid > 0;
+        },
+        std::chrono::seconds(20));
+    if (!up) {
+      ADD_FAILURE() << "mocap sent no heartbeat within 20 s (pid " << first << ")";
+    } else if (const auto r = mannequin::core::signalProcess(first, SIGKILL); r != mannequin::core::SignalResult::kSent) {
+      ADD_FAILURE() << "SIGKILL to mocap pid " << first << " not sent (" << static_cast<int>(r) << ")";
+    } else if (!waitFor(
+                   [&] {
+                     const ServiceStatus s = sup.status()[0];
+                     return s.starts == 2 && s.state == ServiceState::kUp;
+                   },
+                   std::chrono::seconds(20))) {
+      const ServiceStatus s = sup.status()[0];
+      ADD_FAILURE() << "mocap not restarted and up within 20 s of its SIGKILL: starts " << s.starts << ", state "
+                    << toString(s.state);
+    }
     stop = true;
   });
   const int rc = sup.run(stop);
   killer.join();
   std::fclose(out);
-  const auto& st = sup.status()[0];
+  const ServiceStatus st = sup.status()[0];
   EXPECT_EQ(st.starts, 2);
   EXPECT_EQ(st.restarts, 1);
   EXPECT_FALSE(st.clean_exit);  // it was killed once

@@ -5,9 +5,15 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
-#include <filesystem>
 #include <cctype>
+#include <cerrno>
+#include <chrono>
+#include <cstring>
+#include <filesystem>
+#include <optional>
 
+#include "../common/child_process.hpp"
+#include "mannequin/core/process.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
 #include "test_files.hpp"
@@ -206,19 +212,21 @@ TEST(McapCrash, WriterKilledMidChunkLosesAtMostTheOpenChunk) {
   const auto path = tempPath("killed.mcap");
   const int n = 1000;
   const pid_t pid = ::fork();
-  ASSERT_GE(pid, 0);
+  ASSERT_NE(pid, -1) << "fork: " << std::strerror(errno);
   if (pid == 0) {
     McapWriterOptions o;
     o.chunk_size = 2000;
     McapWriter w(path.string(), o);
     writeStream(w, n);  // the last chunk stays open
-    ::kill(::getpid(), SIGKILL);
+    mannequin::core::signalProcess(::getpid(), SIGKILL);
     ::_exit(0);
   }
-  int status = 0;
-  ASSERT_EQ(::waitpid(pid, &status, 0), pid);
-  ASSERT_TRUE(WIFSIGNALED(status));
-  ASSERT_EQ(WTERMSIG(status), SIGKILL);
+  const std::optional<int> code = mannequin::testutil::waitExitWithin(pid, std::chrono::seconds(30));
+  if (!code) {
+    mannequin::testutil::killAndReap(pid);
+    FAIL() << "the writer process " << pid << " did not end within 30 s";
+  }
+  ASSERT_EQ(*code, 128 + SIGKILL) << "the writer process should die of SIGKILL";
   const McapReader r = McapReader::open(path.string());
   std::filesystem::remove(path);
   EXPECT_TRUE(r.recovered());

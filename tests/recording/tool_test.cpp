@@ -1,13 +1,16 @@
 // mannequin-record and mannequin-replay as processes: command lines, --info, damaged files
-// (clear errors, the receiving process keeps running), and a replay into a recorder over ipc.
+// (clear errors, the receiving process keeps running), and a replay into a recorder over ipc (the
+// recorder is stopped once its file holds what was replayed, a wait with a deadline).
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cstdlib>
 #include <filesystem>
 #include <thread>
 
+#include "../common/child_process.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
 #include "test_files.hpp"
@@ -107,38 +110,48 @@ TEST_F(ToolTest, InfoOfCleanTruncatedAndGarbageFiles) {
   EXPECT_NE(r.err.find("junk.mcap: byte 0: not an MCAP file"), std::string::npos) << r.err;
 }
 
-// Starts mannequin-record in the background; returns its pid.
-pid_t startRecorder(const fs::path& bin, const std::string& endpoint, const fs::path& out, const fs::path& log,
-                    double seconds) {
-  const pid_t pid = ::fork();
-  if (pid == 0) {
-    const std::string dur = std::to_string(seconds);
-    std::freopen(log.c_str(), "w", stderr);
-    std::freopen(log.c_str(), "w", stdout);
-    ::execl(bin.c_str(), bin.c_str(), "--connect", endpoint.c_str(), "--out", out.c_str(), "--duration", dur.c_str(),
-            "--progress", "0", static_cast<char*>(nullptr));
-    ::_exit(127);
-  }
-  return pid;
+using namespace std::chrono_literals;
+using mannequin::testutil::Child;
+
+// mannequin-record in the background, until stopped (flushing every 0.1 s: its file can be read back
+// while it records).
+std::vector<std::string> recorderArgs(const fs::path& bin, const std::string& endpoint, const fs::path& out) {
+  return {bin.string(), "--connect", endpoint, "--out", out.string(), "--duration", "120", "--progress", "0", "--flush-interval", "0.1"};
 }
 
-int waitExit(pid_t pid) {
-  int status = 0;
-  ::waitpid(pid, &status, 0);
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+// Waits until `file` (being written: read by the recovery scan) holds `n` messages; false after 30 s.
+bool waitForMessages(const fs::path& file, std::size_t n) {
+  const auto until = std::chrono::steady_clock::now() + 30s;
+  for (;;) {
+    std::size_t have = 0;
+    try {
+      have = McapReader::open(file.string()).readAll().size();
+    } catch (const McapError&) {
+      // nothing readable yet
+    }
+    if (have >= n) return true;
+    if (std::chrono::steady_clock::now() >= until) {
+      ADD_FAILURE() << file << " holds " << have << " of " << n << " messages after 30 s";
+      return false;
+    }
+    std::this_thread::sleep_for(50ms);
+  }
 }
 
 TEST_F(ToolTest, ReplayIntoRecorderKeepsEveryPayload) {
   const fs::path f = makeFile("src.mcap", 500);
   const std::string ep = "ipc://" + (dir_ / "replay.ipc").string();
   const fs::path back = dir_ / "back.mcap";
-  const pid_t rec = startRecorder(binDir() / "mannequin-record", ep, back, dir_ / "record.log", 4.0);
-  const ToolRun r = run("replay", f.string() + " --publish " + ep + " --fast --wait-subscribers 3");
+  Child rec(recorderArgs(binDir() / "mannequin-record", ep, back), (dir_ / "record.log").string());
+  ASSERT_TRUE(rec.started());
+  const ToolRun r = run("replay", f.string() + " --publish " + ep + " --fast --wait-subscribers 20");
   EXPECT_EQ(r.status, 0) << r.err;
-  EXPECT_EQ(waitExit(rec), 0) << slurp(dir_ / "record.log");
   const McapReader a = McapReader::open(f.string());
+  const auto ma = a.readAll();
+  waitForMessages(back, ma.size());
+  EXPECT_EQ(rec.stop(20s), 0) << slurp(dir_ / "record.log");
   const McapReader b = McapReader::open(back.string());
-  const auto ma = a.readAll(), mb = b.readAll();
+  const auto mb = b.readAll();
   ASSERT_EQ(mb.size(), ma.size()) << slurp(dir_ / "record.log");
   for (std::size_t i = 0; i < ma.size(); ++i) ASSERT_EQ(mb[i].data, ma[i].data) << i;
   // the recorder attached the mannequin.v1 schema of the topic
@@ -168,17 +181,17 @@ TEST_F(ToolTest, DamagedFilesGiveClearErrorsAndTheReceiverKeepsRunning) {
 
   const std::string ep = "ipc://" + (dir_ / "replay.ipc").string();
   const fs::path back = dir_ / "back.mcap";
-  const pid_t rec = startRecorder(binDir() / "mannequin-record", ep, back, dir_ / "record.log", 5.0);
-  ToolRun r = run("replay", cut.string() + " --publish " + ep + " --fast --wait-subscribers 3");
+  Child rec(recorderArgs(binDir() / "mannequin-record", ep, back), (dir_ / "record.log").string());
+  ASSERT_TRUE(rec.started());
+  ToolRun r = run("replay", cut.string() + " --publish " + ep + " --fast --wait-subscribers 20");
   EXPECT_EQ(r.status, 0) << r.err;
   EXPECT_NE(r.err.find("recovered 2 chunks"), std::string::npos) << r.err;
-  r = run("replay", bad.string() + " --publish " + ep + " --fast --wait-subscribers 3");
+  r = run("replay", bad.string() + " --publish " + ep + " --fast --wait-subscribers 20");
   EXPECT_EQ(r.status, 1) << r.err;
   EXPECT_NE(r.err.find("bad.mcap: byte " + std::to_string(fourth.chunk_start_offset) + ": Chunk record: CRC mismatch"),
             std::string::npos)
       << r.err;
   // the receiving process was not disturbed and got the complete messages of both replays
-  EXPECT_EQ(waitExit(rec), 0) << slurp(dir_ / "record.log");
   std::size_t first_two = 0, first_three = 0;
   for (int k = 0; k < 3; ++k) {
     ReadFilter rf;
@@ -188,6 +201,8 @@ TEST_F(ToolTest, DamagedFilesGiveClearErrorsAndTheReceiverKeepsRunning) {
     if (k < 2) first_two += n;
     first_three += n;
   }
+  waitForMessages(back, first_two + first_three);
+  EXPECT_EQ(rec.stop(20s), 0) << slurp(dir_ / "record.log");
   EXPECT_EQ(McapReader::open(back.string()).readAll().size(), first_two + first_three);
 }
 

@@ -193,21 +193,40 @@ std::vector<std::string> replayOnce(const std::vector<v1::MocapFrame>& frames, c
   });
   std::atomic<bool> stop{false};
   std::thread runner([&] { sim.run(stop); });
-  // wait until both subscriptions are in place (the sim's on mocap, ours on the sim): heartbeats flow
-  bool ready = false;
-  out.subscribe(transport::topics::kHeartbeat, std::function<void(const v1::Heartbeat&)>([&](const v1::Heartbeat&) { ready = true; }));
-  while (!ready) out.poll(std::chrono::milliseconds(10));
-  while (mocap.subscriptions() < 2) {  // mocap.frame and collision.contacts of the sim's socket
-    mocap.poll();
-    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  // Every wait has a deadline and fails naming what it waited for; the sim is stopped in every case.
+  // 1. both subscriptions in place: ours on the sim (its heartbeats reach us), the sim's on the mocap
+  //    publisher (mocap.frame and collision.contacts of the sim's socket have reached it)
+  // 2. the frames published, then the sim's heartbeats until one counts every frame delivered: in
+  //    replay mode the frames a poll delivers are stepped through before the next heartbeat, and the
+  //    worlds published before that heartbeat reach us before it (one publisher socket)
+  std::uint64_t delivered = 0;
+  bool heartbeat = false;
+  out.subscribe(transport::topics::kHeartbeat, std::function<void(const v1::Heartbeat&)>([&](const v1::Heartbeat& hb) {
+                  heartbeat = true;
+                  for (const auto& t : hb.topics())
+                    if (t.topic() == transport::topics::kMocapFrame.name && !t.published()) delivered = t.messages();
+                }));
+  auto waitFor = [&](auto cond, const char* what) {
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (!cond()) {
+      if (std::chrono::steady_clock::now() >= until) {
+        ADD_FAILURE() << "replayOnce: no " << what << " within 20 s";
+        return false;
+      }
+      out.poll(std::chrono::milliseconds(5));
+      mocap.poll();
+    }
+    return true;
+  };
+  if (waitFor([&] { return heartbeat; }, "heartbeat of the sim") &&
+      waitFor([&] { return mocap.subscriptions() >= 2; }, "subscription of the sim to mocap.frame and collision.contacts")) {
+    for (v1::MocapFrame f : frames) mocap.publish(transport::topics::kMocapFrame, f);
+    waitFor([&] { return delivered >= frames.size(); }, "heartbeat counting every mocap frame delivered");
+    EXPECT_EQ(delivered, frames.size());
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(200));
-  for (v1::MocapFrame f : frames) mocap.publish(transport::topics::kMocapFrame, f);
-  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(20);
-  while (std::chrono::steady_clock::now() < until && worlds.size() < expected) out.poll(std::chrono::milliseconds(10));
-  out.poll(std::chrono::milliseconds(100));  // and nothing more comes
   stop = true;
   runner.join();
+  EXPECT_EQ(worlds.size(), expected);
   return worlds;
 }
 }  // namespace

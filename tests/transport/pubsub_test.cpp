@@ -102,19 +102,44 @@ TEST(PubSub, LatestOnlyDeliversTheNewestStateOfABacklog) {
   std::vector<v1::WorldState> got;
   sub.subscribe(topics::kSimWorld, collect(got));
   ASSERT_TRUE(handshake(pub, sub));
-  for (int i = 1; i <= 50; ++i) {
-    v1::WorldState w;
-    w.set_step(i);
-    pub.publish(topics::kSimWorld, w);
+  // Bursts of 50 states, drained by polls until all 50 are received: whatever part of the burst a
+  // poll drains, it delivers only its newest state and counts the others superseded, and the last
+  // state delivered is the newest of the burst. Bursts are repeated until one poll drained a backlog
+  // (more than one state): how the burst is split over polls is up to the sockets' timing.
+  std::uint64_t step = 0;
+  bool backlog = false;
+  for (int burst = 0; burst < 20 && !backlog; ++burst) {
+    const TopicCounters start = sub.counters("sim.world");
+    for (int i = 0; i < 50; ++i) {
+      v1::WorldState w;
+      w.set_step(++step);
+      pub.publish(topics::kSimWorld, w);
+    }
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (sub.counters("sim.world").received - start.received < 50) {
+      ASSERT_LT(std::chrono::steady_clock::now(), until)
+          << "burst " << burst << ": " << sub.counters("sim.world").received - start.received << " of 50 states received in 10 s";
+      const TopicCounters before = sub.counters("sim.world");
+      const std::size_t delivered_before = got.size();
+      sub.poll(std::chrono::milliseconds(2));
+      const TopicCounters after = sub.counters("sim.world");
+      const std::uint64_t drained = after.received - before.received;
+      ASSERT_EQ(got.size() - delivered_before, drained > 0 ? 1u : 0u) << "one state per poll, of " << drained << " drained";
+      EXPECT_EQ(after.superseded - before.superseded, drained > 0 ? drained - 1 : 0u);
+      EXPECT_EQ(after.delivered - before.delivered, drained > 0 ? 1u : 0u);
+      if (drained > 0) {
+        EXPECT_EQ(got.back().step(), step - 50 + (after.received - start.received)) << "the newest drained";
+      }
+      backlog = backlog || drained > 1;
+    }
+    ASSERT_FALSE(got.empty());
+    EXPECT_EQ(got.back().step(), step);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));  // let all 50 reach the socket
-  sub.poll(std::chrono::milliseconds(0));
-  ASSERT_EQ(got.size(), 1u);
-  EXPECT_EQ(got[0].step(), 50u);
+  EXPECT_TRUE(backlog) << "no poll drained more than one state in 20 bursts of 50";
   const TopicCounters c = sub.counters("sim.world");
-  EXPECT_EQ(c.received, 50u);
-  EXPECT_EQ(c.superseded, 49u);
-  EXPECT_EQ(c.delivered, 1u);
+  EXPECT_EQ(c.received, step);
+  EXPECT_EQ(c.delivered + c.superseded, step);
+  EXPECT_EQ(c.delivered, got.size());
   EXPECT_EQ(c.dropped, 0u);
 }
 
@@ -249,17 +274,47 @@ TEST(PubSub, LatestOnlyKeepsTheNewestOfEachSource) {
   sub.subscribe(topics::kSimWorld, collect(got));
   ASSERT_TRUE(handshake(a, sub));
   ASSERT_TRUE(handshake(b, sub));
-  for (int i = 1; i <= 5; ++i) {
-    v1::WorldState w;
-    w.set_step(i);
-    a.publish(topics::kSimWorld, w);
-    w.set_step(100 + i);
-    b.publish(topics::kSimWorld, w);
+  // Bursts of 5 states from each source, drained by polls until all 10 are received: a poll delivers
+  // at most one state per source, its newest (a newer state of one source never hides the other's);
+  // the last delivered of each source is its newest. Repeated until one poll delivered both sources
+  // after superseding (how a burst is split over polls is up to the sockets' timing).
+  std::uint64_t step = 0;
+  bool both = false;
+  for (int burst = 0; burst < 20 && !both; ++burst) {
+    const TopicCounters start = sub.counters("sim.world");
+    for (int i = 0; i < 5; ++i) {
+      v1::WorldState w;
+      w.set_step(++step);
+      a.publish(topics::kSimWorld, w);
+      w.set_step(1000 + step);
+      b.publish(topics::kSimWorld, w);
+    }
+    std::uint64_t last_a = 0, last_b = 0;
+    const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(10);
+    while (sub.counters("sim.world").received - start.received < 10) {
+      ASSERT_LT(std::chrono::steady_clock::now(), until)
+          << "burst " << burst << ": " << sub.counters("sim.world").received - start.received << " of 10 states received in 10 s";
+      const TopicCounters before = sub.counters("sim.world");
+      const std::size_t first = got.size();
+      sub.poll(std::chrono::milliseconds(2));
+      const TopicCounters after = sub.counters("sim.world");
+      int from_a = 0, from_b = 0;
+      for (std::size_t k = first; k < got.size(); ++k) {
+        const bool is_a = got[k].header().source() == "sim_a";
+        (is_a ? from_a : from_b) += 1;
+        (is_a ? last_a : last_b) = got[k].step();
+      }
+      EXPECT_LE(from_a, 1);
+      EXPECT_LE(from_b, 1);
+      const std::uint64_t drained = after.received - before.received;
+      EXPECT_EQ(after.superseded - before.superseded + (got.size() - first), drained);
+      both = both || (from_a == 1 && from_b == 1 && after.superseded > before.superseded);
+    }
+    EXPECT_EQ(last_a, step);
+    EXPECT_EQ(last_b, 1000 + step);
   }
-  std::this_thread::sleep_for(std::chrono::milliseconds(50));
-  sub.poll(std::chrono::milliseconds(0));
-  ASSERT_EQ(got.size(), 2u);
-  std::set<std::uint64_t> steps{got[0].step(), got[1].step()};
-  EXPECT_EQ(steps, (std::set<std::uint64_t>{5, 105}));
-  EXPECT_EQ(sub.counters("sim.world").superseded, 8u);
+  EXPECT_TRUE(both) << "no poll delivered both sources after superseding in 20 bursts";
+  const TopicCounters c = sub.counters("sim.world");
+  EXPECT_EQ(c.received, 2 * step);
+  EXPECT_EQ(c.delivered + c.superseded, 2 * step);
 }

@@ -3,13 +3,15 @@
 /// \brief Runs a deployment on this host: starts every service (fork/exec, own process group, killed
 /// with the launcher through PR_SET_PDEATHSIG), prefixes and forwards their output line by line,
 /// follows their heartbeats, restarts a crashed service with exponential backoff, and stops everything
-/// (SIGTERM in reverse start order, SIGKILL after the stop timeout, every child reaped).
+/// (SIGTERM in reverse start order, SIGKILL after the stop timeout, every child reaped). Every signal
+/// goes through core::signalProcess (a pid ≤ 0 — a service not running — is never signalled).
 #include <sys/types.h>
 
 #include <atomic>
 #include <cstdint>
 #include <cstdio>
 #include <memory>
+#include <mutex>
 #include <string>
 #include <vector>
 
@@ -25,7 +27,7 @@ const char* toString(ServiceState s);
 struct ServiceStatus {
   std::string name;
   ServiceState state = ServiceState::kStarting;
-  pid_t pid = -1;
+  pid_t pid = -1;                 ///< -1 while not running (not started, exited, in backoff)
   std::vector<pid_t> pids;        ///< every pid it ran as
   int starts = 0;
   int restarts = 0;
@@ -52,10 +54,12 @@ class Supervisor {
   /// Runs until `stop` becomes true (SIGINT/SIGTERM) or the duration elapses, then stops everything.
   /// Returns 0 when every service ran and stopped cleanly, 1 if one failed permanently or exited badly.
   int run(const std::atomic<bool>& stop);
-  const std::vector<ServiceStatus>& status() const { return status_; }
-  /// "3/3 up | mocap 120 Hz | sim 1000 Hz, world 60.0 Hz, late 0.2 ms | ..."
+  /// A copy of the status of every service, safe to call from any thread while run() works (a
+  /// snapshot taken after each iteration of run()'s loop and at its end).
+  std::vector<ServiceStatus> status() const;
+  /// "3/3 up | mocap 120 Hz | sim 1000 Hz, world 60.0 Hz, late 0.2 ms | ..." (of status()).
   std::string statusLine() const;
-  /// Multi-line summary printed at the end.
+  /// Multi-line summary printed at the end (of status()).
   std::string summary() const;
   /// The same as JSON.
   std::string summaryJson() const;
@@ -67,7 +71,11 @@ class Supervisor {
   std::unique_ptr<Impl> impl_;
   Deployment deployment_;
   SupervisorOptions options_;
-  std::vector<ServiceStatus> status_;
+  std::vector<ServiceStatus> status_;     ///< run()'s working copy (only run()'s thread touches it)
+  mutable std::mutex snapshot_mutex_;
+  std::vector<ServiceStatus> snapshot_;   ///< what status() returns (guarded by snapshot_mutex_)
+  void publishSnapshot();
+  static std::string statusLineOf(const std::vector<ServiceStatus>& status);
 };
 
 }  // namespace mannequin::deploy
