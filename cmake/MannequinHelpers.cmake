@@ -10,8 +10,12 @@ if(MANNEQUIN_SANITIZE)
   target_compile_options(mannequin_options INTERFACE -fsanitize=${MANNEQUIN_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all)
   target_link_options(mannequin_options INTERFACE -fsanitize=${MANNEQUIN_SANITIZE})
 endif()
+# A checking build: EIGEN_RUNTIME_NO_MALLOC lets a test forbid Eigen heap allocations in a hot loop
+# (Eigen::internal::set_is_malloc_allowed(false), tests/common/no_eigen_malloc.hpp), and asserts stay on
+# (-UNDEBUG, also in Release) so the forbidden allocation fails eigen_assert wherever it happens.
 if(MANNEQUIN_CHECK_RUNTIME_MALLOC)
   target_compile_definitions(mannequin_options INTERFACE EIGEN_RUNTIME_NO_MALLOC)
+  target_compile_options(mannequin_options INTERFACE -UNDEBUG)
 endif()
 
 # mannequin_add_library(<name> SOURCES ... [DEPS ...] [PRIVATE_DEPS ...])

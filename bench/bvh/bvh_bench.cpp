@@ -9,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "bench_main.hpp"
 #include "mannequin/skeleton/bvh.hpp"
 
 namespace sk = mannequin::skeleton;
@@ -16,18 +17,14 @@ namespace sk = mannequin::skeleton;
 namespace {
 
 constexpr int kFrames = 10000;
-
-std::string sourceDir() {
-  const char* env = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return env ? env : MANNEQUIN_DEFAULT_SOURCE_DIR;
-}
+constexpr const char* kCapture = "data/bvh/cmu_max_131_03.bvh";
 
 // the CMU capture's hierarchy followed by its 1102 frame lines repeated up to kFrames frames
 const std::string& bigCapture() {
   static const std::string text = [] {
-    const std::string path = sourceDir() + "/data/bvh/cmu_max_131_03.bvh";
+    const std::string path = mannequin::bench::dataFile(kCapture);
     std::ifstream in(path, std::ios::binary);
-    if (!in) throw std::runtime_error("bench-bvh: cannot open " + path + " (set MANNEQUIN_SOURCE_DIR)");
+    if (!in) throw std::runtime_error("cannot open " + path);
     std::ostringstream s;
     s << in.rdbuf();
     const std::string full = s.str();
@@ -104,4 +101,4 @@ BENCHMARK(BM_BvhForwardKinematics10kFrames)->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
-BENCHMARK_MAIN();
+MANNEQUIN_BENCHMARK_MAIN("bench-bvh", kCapture)

@@ -1,7 +1,7 @@
 // bench-collision: CollisionWorld::query per step in (a) one mannequin on a floor, (b) two mannequins
 // around a table, (c) one seated mannequin in the 14k-triangle cockpit, (d) a stress case with
 // ~280 contacts; plus raw FCL references (broadphase vs a box floor, per-capsule distance to
-// the panel mesh: the trap). Run from the repository root (scenes are read from configs/).
+// the panel mesh: the trap). Runs from any directory (configs/ and data/ found by core::findData).
 #include <benchmark/benchmark.h>
 #include <fcl/broadphase/broadphase_dynamic_AABB_tree.h>
 #include <fcl/geometry/bvh/BVH_model.h>
@@ -16,6 +16,7 @@
 #include <memory>
 #include <string>
 
+#include "bench_main.hpp"
 #include "mannequin/collision/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
@@ -27,10 +28,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-std::string path(const std::string& rel) {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return std::string(root ? root : ".") + "/" + rel;
-}
+std::string path(const std::string& rel) { return mannequin::bench::dataFile(rel); }
 
 const skeleton::Model& model() {
   static const skeleton::Model m =
@@ -295,4 +293,5 @@ BENCHMARK(BM_RawFcl_PerCapsuleDistanceVsPanelMesh)->Unit(benchmark::kMillisecond
 
 }  // namespace
 
-BENCHMARK_MAIN();
+MANNEQUIN_BENCHMARK_MAIN("bench-collision", "configs/mannequins/male_50th.yaml", "configs/scenes/floor.yaml",
+                         "configs/scenes/table.yaml", "configs/scenes/cockpit.yaml", "data/meshes/cockpit_panel.obj")

@@ -11,6 +11,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "bench_main.hpp"
 #include "mannequin/control/controller.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
@@ -18,17 +19,13 @@ using namespace mannequin;
 using namespace mannequin::control;
 
 namespace {
-std::string sourceDir() {
-  const char* env = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return env ? env : MANNEQUIN_DEFAULT_SOURCE_DIR;
-}
 const skeleton::Model& model() {
   static const skeleton::Model m =
-      skeleton::buildMannequin(skeleton::loadMannequinSpec(sourceDir() + "/configs/mannequins/male_50th.yaml"));
+      skeleton::buildMannequin(skeleton::loadMannequinSpec(mannequin::bench::dataFile("configs/mannequins/male_50th.yaml")));
   return m;
 }
 ControllerConfig config(ProjectorMethod method) {
-  ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+  ControllerConfig c = loadControllerConfig(mannequin::bench::dataFile("configs/control/default.yaml"));
   c.projector = method;
   return c;
 }
@@ -97,4 +94,4 @@ static void BM_Projector(benchmark::State& state) {
 }
 BENCHMARK(BM_Projector)->Arg(0)->Arg(1)->Unit(benchmark::kMicrosecond);
 
-BENCHMARK_MAIN();
+MANNEQUIN_BENCHMARK_MAIN("bench-control", "configs/mannequins/male_50th.yaml", "configs/control/default.yaml")

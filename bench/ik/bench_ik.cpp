@@ -11,6 +11,7 @@
 #include <random>
 #include <string>
 
+#include "bench_main.hpp"
 #include "mannequin/ik/solver.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
@@ -45,14 +46,10 @@ void BM_PriorityLoop(benchmark::State& state) {
 BENCHMARK(BM_PriorityLoop)->ArgsProduct({{0, 1}, {1, 2, 3, 4, 5, 6, 7, 8, 9, 10}})->ArgNames({"full", "p"})
     ->Unit(benchmark::kMicrosecond);
 
-std::string sourceDir() {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return root ? root : ".";
-}
 
 struct Mannequin {
   skeleton::Model model =
-      skeleton::buildMannequin(skeleton::loadMannequinSpec(sourceDir() + "/configs/mannequins/male_50th.yaml"));
+      skeleton::buildMannequin(skeleton::loadMannequinSpec(mannequin::bench::dataFile("configs/mannequins/male_50th.yaml")));
   VectorX q0 = skeleton::standingConfiguration(model);
 };
 
@@ -139,14 +136,9 @@ int main(int argc, char** argv) {
   bool console = true;  // (read before Initialize, which consumes the flags)
   for (int i = 1; i < argc; ++i)
     if (std::strncmp(argv[i], "--benchmark_format=", 19) == 0 && std::strcmp(argv[i] + 19, "console") != 0) console = false;
-  benchmark::Initialize(&argc, argv);
-  if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
-  if (console) {
+  return mannequin::bench::guarded("bench-ik", [&] {
+    mannequin::bench::requireData({"configs/mannequins/male_50th.yaml"});
     Fig5Reporter reporter;
-    benchmark::RunSpecifiedBenchmarks(&reporter);
-  } else {
-    benchmark::RunSpecifiedBenchmarks();
-  }
-  benchmark::Shutdown();
-  return 0;
+    return mannequin::bench::runSpecified(argc, argv, console ? &reporter : nullptr);
+  });
 }

@@ -4,6 +4,7 @@
 
 #include <random>
 
+#include "bench_main.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 
@@ -72,4 +73,4 @@ static void BM_FullKinematicsWithSegmentJacobians(benchmark::State& state) {
 }
 BENCHMARK(BM_FullKinematicsWithSegmentJacobians);
 
-BENCHMARK_MAIN();
+MANNEQUIN_BENCHMARK_MAIN("bench-kinematics")

@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 
+#include "bench_main.hpp"
 #include "mannequin/lcp/lemke.hpp"
 #include "mannequin/lcp/pgs.hpp"
 #include "mannequin/lcp/structured.hpp"
@@ -171,9 +172,8 @@ int main(int argc, char** argv) {
 #ifndef MANNEQUIN_HAVE_SICONOS
   std::fprintf(stderr, "bench-lcp: Siconos numerics not found at build time, comparison skipped\n");
 #endif
-  registerAll();
-  benchmark::Initialize(&argc, argv);
-  benchmark::RunSpecifiedBenchmarks();
-  benchmark::Shutdown();
-  return 0;
+  return mannequin::bench::guarded("bench-lcp", [&] {
+    registerAll();
+    return mannequin::bench::runSpecified(argc, argv);
+  });
 }

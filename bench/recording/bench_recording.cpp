@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "bench_main.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
 
@@ -115,4 +116,4 @@ BENCHMARK(BM_Write)->ArgNames({"zstd", "chunk"})->Args({0, 1 << 20})->Args({1, 1
 BENCHMARK(BM_Read)->ArgNames({"zstd"})->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond)->UseRealTime();
 BENCHMARK(BM_SeekOneSecond)->Unit(benchmark::kMillisecond)->UseRealTime();
 
-BENCHMARK_MAIN();
+MANNEQUIN_BENCHMARK_MAIN("bench-recording")

@@ -12,6 +12,7 @@
 #include <cstdlib>
 #include <string>
 
+#include "bench_main.hpp"
 #include "mannequin/control/config.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/sim/world.hpp"
@@ -21,19 +22,15 @@ using namespace mannequin;
 using namespace mannequin::sim;
 
 namespace {
-std::string sourceDir() {
-  const char* env = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return env ? env : MANNEQUIN_DEFAULT_SOURCE_DIR;
-}
 
 const char* kBodies[] = {"pelvis", "head", "hand_l", "hand_r", "foot_l", "foot_r"};
 
 void worldStep(benchmark::State& state, bool controller, bool feed_forward) {
   MannequinSetup m;
   m.name = "operator";
-  m.model = skeleton::buildMannequin(skeleton::loadMannequinSpec(sourceDir() + "/configs/mannequins/male_50th.yaml"));
+  m.model = skeleton::buildMannequin(skeleton::loadMannequinSpec(mannequin::bench::dataFile("configs/mannequins/male_50th.yaml")));
   for (const char* b : kBodies) m.frames.push_back({b, b});
-  if (controller) m.controller = control::loadControllerConfig(sourceDir() + "/configs/control/mocap.yaml");
+  if (controller) m.controller = control::loadControllerConfig(mannequin::bench::dataFile("configs/control/mocap.yaml"));
   skeleton::Data d(m.model);
   skeleton::forwardKinematics(m.model, d, skeleton::standingConfiguration(m.model));
   std::vector<math::SE3> rest;
@@ -85,4 +82,4 @@ BENCHMARK_CAPTURE(BM_WorldStep, controller, true, true)->Unit(benchmark::kMicros
 BENCHMARK_CAPTURE(BM_WorldStep, controller_no_target_twist, true, false)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 BENCHMARK_CAPTURE(BM_WorldStep, kinematic, false, false)->Unit(benchmark::kMicrosecond)->MinTime(2.0);
 
-BENCHMARK_MAIN();
+MANNEQUIN_BENCHMARK_MAIN("bench-step", "configs/mannequins/male_50th.yaml", "configs/control/mocap.yaml")

@@ -14,6 +14,7 @@
 #include <filesystem>
 #include <thread>
 
+#include "bench_main.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/simservice/messages.hpp"
 #include "mannequin/simservice/sim_service.hpp"
@@ -26,6 +27,18 @@ using namespace mannequin;
 namespace topics = transport::topics;
 
 namespace {
+constexpr const char* kSimConfig = "configs/sim/sim_demo.yaml";
+
+// the demo's sim config with its mannequin and controller files found from any working directory
+simservice::SimServiceConfig simDemoConfig() {
+  simservice::SimServiceConfig cfg = simservice::loadSimConfig(mannequin::bench::dataFile(kSimConfig));
+  for (auto& m : cfg.mannequins) {
+    m.config = mannequin::bench::dataFile(m.config);
+    if (!m.controller.empty()) m.controller = mannequin::bench::dataFile(m.controller);
+  }
+  return cfg;
+}
+
 std::string ipcDir() {
   static const std::string dir = [] {
     auto p = std::filesystem::temp_directory_path() / ("bench-transport-" + std::to_string(getpid()));
@@ -65,7 +78,7 @@ BENCHMARK(PubSub)->ArgsProduct({{64, 2048, 16384}, {0, 1}})->UseRealTime()->Unit
 
 // a WorldState exactly as the sim publishes it (the demo's 43-DoF mannequin, 6 control frames)
 std::string worldPayload() {
-  const simservice::SimServiceConfig cfg = simservice::loadSimConfig("configs/sim/sim_demo.yaml");
+  const simservice::SimServiceConfig cfg = simDemoConfig();
   sim::World world(simservice::buildMannequins(cfg), cfg.world);
   world.step();
   v1::WorldState w;
@@ -120,7 +133,7 @@ void MocapToWorld(benchmark::State& state) {
     zmq::context_t ctx;
     const std::string dir = ipcDir();
     transport::Publisher mocap(ctx, {"mocap", {"ipc://" + dir + "/m2w-mocap"}});
-    simservice::SimServiceConfig cfg = simservice::loadSimConfig("configs/sim/sim_demo.yaml");
+    simservice::SimServiceConfig cfg = simDemoConfig();
     cfg.mode = simservice::Mode::kLive;
     cfg.publish = {"ipc://" + dir + "/m2w-sim"};
     cfg.connect = {"ipc://" + dir + "/m2w-mocap"};
@@ -188,4 +201,4 @@ BENCHMARK(MocapToWorld)->Arg(10000)->Iterations(1)->UseRealTime()->Unit(benchmar
 
 }  // namespace
 
-BENCHMARK_MAIN();
+MANNEQUIN_BENCHMARK_MAIN("bench-transport", kSimConfig)

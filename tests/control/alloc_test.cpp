@@ -1,13 +1,15 @@
 // The control step allocates nothing after construction: the three stages with a constraint force,
 // two priority levels, the internal control and an enabled virtual mechanism. malloc is
-// interposed, so this runs only without AddressSanitizer (which owns malloc).
+// interposed, so this runs only without AddressSanitizer (which owns malloc). With
+// -DMANNEQUIN_CHECK_RUNTIME_MALLOC=ON the loop also runs under NoEigenMalloc: an Eigen allocation
+// asserts at the line that makes it.
 #include <gtest/gtest.h>
 
 #include <cstddef>
 
 #include "common.hpp"
 #include "../common/alloc_counter.hpp"
-
+#include "../common/no_eigen_malloc.hpp"
 
 using namespace mannequin;
 using namespace mannequin::control;
@@ -34,6 +36,7 @@ TEST(ControlAlloc, StepAllocatesNothing) {
     SE3 target = ctl.frame(ctl.frameIndex("hand_l")).pose;
     ctl.step();  // warm-up
     const long allocations = countAllocations([&] {
+      const NoEigenMalloc no_eigen_malloc;
       for (int i = 0; i < 50; ++i) {
         target.p.x() += 1e-4;
         ctl.setTarget(ctl.frameIndex("hand_l"), target);

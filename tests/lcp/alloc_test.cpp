@@ -10,6 +10,7 @@
 #include "mannequin/lcp/structured.hpp"
 #include "mannequin/lcp/testing.hpp"
 #include "../common/alloc_counter.hpp"
+#include "../common/no_eigen_malloc.hpp"
 
 using namespace mannequin::lcp;
 
@@ -32,6 +33,42 @@ TEST(Allocation, LemkeDoesNotAllocatePerPivot) {
   EXPECT_GE(b.pivots, 20);
   EXPECT_GT(na, 0);  // the counter sees the result vectors, so it is live
   EXPECT_EQ(na, nb);
+}
+
+// the in-place form for a real-time loop: nothing at all once the result and the workspace have
+// size n, whatever the path (pivots, ray and retries); under NoEigenMalloc when the build checks it
+TEST(Allocation, LemkeInPlaceAllocatesNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "malloc is owned by AddressSanitizer";
+#endif
+  const Index n = 40;
+  const LcpProblem spd = gen::makeSpd(n, 3);
+  LcpProblem trivial = spd;
+  trivial.q.setOnes();
+  // PSD with a ray (rows 0 and 1 opposite, both distances negative): NoSolution after the retries
+  auto c = gen::makeContactLike(n, 7);
+  c.A.row(1) = -c.A.row(0);
+  LcpProblem ray{c.A * c.A.transpose(), c.lcp.q};
+  ray.q[0] = -0.01;
+  ray.q[1] = -0.01;
+  LemkeWorkspace ws(n);
+  LcpResult r;
+  solveLemke(ray, ws, {}, r);  // warm-up: sizes the result and the retry result
+  for (const LcpProblem* p : std::initializer_list<const LcpProblem*>{&spd, &trivial, &ray}) {
+    LcpStatus status = LcpStatus::Invalid;
+    const long allocations = countAllocations([&] {
+      const NoEigenMalloc no_eigen_malloc;
+      status = solveLemke(*p, ws, {}, r);
+    });
+    EXPECT_EQ(allocations, 0) << statusName(status);
+    EXPECT_EQ(status, r.status);
+    EXPECT_EQ(status, p == &ray ? LcpStatus::NoSolution : LcpStatus::Solved) << r.message;
+    // same answer as the allocating form
+    const LcpResult fresh = solveLemke(*p, ws);
+    EXPECT_EQ(fresh.status, r.status);
+    EXPECT_EQ(fresh.pivots, r.pivots);
+    EXPECT_EQ((fresh.z - r.z).lpNorm<Eigen::Infinity>(), 0.0);
+  }
 }
 
 TEST(Allocation, PgsAndStructuredDoNotAllocatePerStep) {

@@ -1,6 +1,10 @@
 #include <gtest/gtest.h>
 
+#include <Eigen/QR>
 #include <limits>
+#include <random>
+#include <string>
+#include <vector>
 
 #include "mannequin/lcp/lemke.hpp"
 #include "mannequin/lcp/testing.hpp"
@@ -31,6 +35,100 @@ void expectSolved(const LcpResult& r) {
   EXPECT_LE(r.residuals.relative_sign, 1e-9);
   EXPECT_TRUE(r.z.allFinite());
   EXPECT_TRUE(r.w.allFinite());
+}
+
+// Independent decision of solvability for small n, by enumeration. Write w − M z = q as A x = q
+// with A = [I, −M] and x = (w, z) ≥ 0. If the LCP has a solution, the solutions with the same
+// support form a polyhedron in the orthant, which has a vertex: a nonnegative x on linearly
+// independent columns, taken from a complementary set (for each i: w_i, or z_i, or neither).
+// Trying every such set (3ⁿ) for a nonnegative least-squares-consistent x decides solvability.
+// Returns true and fills z when one is found (residuals at `tol` relative to the data).
+bool solvableByEnumeration(const LcpProblem& p, Eigen::VectorXd* z_found = nullptr, double tol = 1e-9) {
+  const Index n = p.q.size();
+  if (n > 12) {
+    ADD_FAILURE() << "enumeration is for n <= 12, got " << n;
+    return false;
+  }
+  const double scale = 1.0 + std::max(p.M.cwiseAbs().maxCoeff(), p.q.cwiseAbs().maxCoeff());
+  long total = 1;
+  for (Index i = 0; i < n; ++i) total *= 3;
+  Eigen::MatrixXd A(n, n);
+  std::vector<Index> which(static_cast<std::size_t>(n));  // 0 neither, 1 w_i, 2 z_i
+  for (long code = 0; code < total; ++code) {
+    long c = code;
+    Index k = 0;
+    for (Index i = 0; i < n; ++i, c /= 3) {
+      which[static_cast<std::size_t>(i)] = static_cast<Index>(c % 3);
+      if (c % 3 == 1) A.col(k++) = Eigen::VectorXd::Unit(n, i);
+      if (c % 3 == 2) A.col(k++) = -p.M.col(i);
+    }
+    Eigen::VectorXd x = Eigen::VectorXd::Zero(k);
+    if (k > 0) x = A.leftCols(k).colPivHouseholderQr().solve(p.q);
+    if (k > 0 && x.minCoeff() < -tol * scale) continue;
+    if ((A.leftCols(k) * x - p.q).lpNorm<Eigen::Infinity>() > tol * scale) continue;
+    if (z_found != nullptr) {
+      z_found->setZero(n);
+      Index col = 0;
+      for (Index i = 0; i < n; ++i) {
+        const Index w = which[static_cast<std::size_t>(i)];
+        if (w == 2) (*z_found)[i] = std::max(0.0, x[col]);
+        if (w != 0) ++col;
+      }
+    }
+    return true;
+  }
+  return false;
+}
+
+// Lemke on a PSD (hence copositive-plus) M is a decision procedure: Solved iff a solution exists,
+// NoSolution (ray) iff none. Checks the answer against the independent decision.
+void expectLemkeDecides(const LcpProblem& p, bool solvable, LemkeWorkspace& ws, const std::string& what) {
+  SCOPED_TRACE(what);
+  const auto r = solveLemke(p, ws);
+  if (solvable) {
+    expectSolved(r);
+  } else {
+    EXPECT_EQ(r.status, LcpStatus::NoSolution) << r.message;
+  }
+}
+
+// Symmetric PSD M = BBᵀ (B n×r) with a known solution: z* ≥ 0 on a random support, w* ≥ 0 on the
+// rest, some of both exactly 0 (degenerate), q = w* − M z*.
+LcpProblem psdWithSolution(Index n, Index r, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  LcpProblem p;
+  const Eigen::MatrixXd B = gen::uniform(n, r, -1.0, 1.0, rng);
+  p.M = B * B.transpose();
+  Eigen::VectorXd z = Eigen::VectorXd::Zero(n), w = Eigen::VectorXd::Zero(n);
+  for (Index i = 0; i < n; ++i) {
+    const double pick = u(rng);
+    if (pick < 0.4) z[i] = u(rng);
+    else if (pick < 0.8) w[i] = u(rng);  // else both 0
+  }
+  p.q = w - p.M * z;
+  return p;
+}
+
+// Symmetric PSD M = BBᵀ with an infeasibility certificate y ≥ 0, M y = 0, qᵀy < 0: B's columns are
+// made orthogonal to y, and q is shifted along y. Then for any z ≥ 0, yᵀ(M z + q) = qᵀy < 0, so
+// M z + q ≥ 0 is impossible: the LCP has no solution.
+LcpProblem psdInfeasible(Index n, Index r, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  std::uniform_real_distribution<double> u(0.0, 1.0);
+  Eigen::VectorXd y = Eigen::VectorXd::Zero(n);
+  for (Index i = 0; i < n; ++i)
+    if (u(rng) < 0.3) y[i] = u(rng);
+  y[static_cast<Index>(u(rng) * static_cast<double>(n)) % n] = 1.0;  // y ≠ 0
+  Eigen::MatrixXd B = gen::uniform(n, r, -1.0, 1.0, rng);
+  B -= y * (y.transpose() * B) / y.squaredNorm();
+  LcpProblem p;
+  p.M = B * B.transpose();
+  p.q = gen::uniform(n, 1, -1.0, 1.0, rng);
+  p.q -= (p.q.dot(y) + 0.1 * y.norm()) / y.squaredNorm() * y;  // qᵀy = −0.1‖y‖
+  EXPECT_LE((p.M * y).lpNorm<Eigen::Infinity>(), 1e-12);
+  EXPECT_LT(p.q.dot(y), 0.0);
+  return p;
 }
 
 }  // namespace
@@ -113,9 +211,8 @@ TEST(Lemke, DegenerateZerosInQ) {
   p.M.row(3) = p.M.row(1);
   p.M.col(3) = p.M.col(1);
   p.q[3] = p.q[1];
-  const auto r = solveLemke(p, ws);
-  ASSERT_TRUE(r.status == LcpStatus::Solved || r.status == LcpStatus::NoSolution) << r.message;
-  if (r.status == LcpStatus::Solved) expectSolved(r);
+  // M stays PSD (row and column 3 copy 1: M = B'B'ᵀ); solvable or not, Lemke must decide it
+  expectLemkeDecides(p, solvableByEnumeration(p), ws, "zeros in q, repeated row");
 }
 
 // bad input is reported, never a crash
@@ -173,12 +270,72 @@ TEST(Lemke, RandomFamiliesSolvedAreComplementary) {
       expectSolved(r);  // SPD, P and strictly copositive LCPs always have a solution
       ++solved;
     }
-    const auto psd = gen::makePsd(n, n / 3 + 1, seed);
-    const auto r = solveLemke(psd, ws);
-    ASSERT_NE(r.status, LcpStatus::PivotLimit);
-    if (r.status == LcpStatus::Solved) expectSolved(r);
   }
   EXPECT_EQ(solved, 45);
+}
+
+// PSD (copositive-plus): Lemke solves whenever a solution exists and reports NoSolution only when
+// there is none, decided independently by enumeration (n ≤ 8), including degenerate variants
+// (zeros in q, repeated rows). Both outcomes must occur in the family for the test to mean anything.
+TEST(Lemke, PsdAgreesWithEnumeration) {
+  LemkeWorkspace ws;
+  int solvable = 0, unsolvable = 0;
+  for (std::uint32_t seed = 1; seed <= 40; ++seed) {
+    const Index n = 2 + static_cast<Index>(seed % 7);
+    const Index r = 1 + static_cast<Index>(seed % static_cast<std::uint32_t>(n));
+    std::vector<LcpProblem> family{gen::makePsd(n, r, seed)};
+    LcpProblem zeros = family[0];
+    for (Index i = 0; i < n; i += 2) zeros.q[i] = 0.0;
+    family.push_back(zeros);
+    if (n >= 3) {
+      LcpProblem repeated = family[0];
+      repeated.M.row(2) = repeated.M.row(0);
+      repeated.M.col(2) = repeated.M.col(0);
+      repeated.q[2] = repeated.q[0];
+      family.push_back(repeated);
+    }
+    for (std::size_t f = 0; f < family.size(); ++f) {
+      const bool has = solvableByEnumeration(family[f]);
+      (has ? solvable : unsolvable)++;
+      expectLemkeDecides(family[f], has, ws, "seed " + std::to_string(seed) + " n " + std::to_string(n) +
+                                                 " rank " + std::to_string(r) + " variant " + std::to_string(f));
+    }
+  }
+  EXPECT_GT(solvable, 0);
+  EXPECT_GT(unsolvable, 0);
+}
+
+// the enumeration agrees with the theory on the classes where a solution always exists
+TEST(Lemke, EnumerationFindsTheSolutionOfPAndCopositiveProblems) {
+  LemkeWorkspace ws;
+  for (std::uint32_t seed = 1; seed <= 10; ++seed) {
+    const Index n = 2 + static_cast<Index>(seed % 6);
+    for (const auto& p : {gen::makeSpd(n, seed), gen::makePMatrix(n, seed), gen::makeCopositive(n, seed)}) {
+      ASSERT_TRUE(solvableByEnumeration(p));
+      expectSolved(solveLemke(p, ws));
+    }
+    // P-matrix: the solution is unique, so Lemke's is the enumerated one
+    for (const auto& p : {gen::makeSpd(n, seed), gen::makePMatrix(n, seed)}) {
+      Eigen::VectorXd z;
+      ASSERT_TRUE(solvableByEnumeration(p, &z));
+      EXPECT_LE((solveLemke(p, ws).z - z).lpNorm<Eigen::Infinity>(), 1e-8);
+    }
+  }
+}
+
+// larger PSD problems (n up to 60, rank-deficient) built with a known solution or a known
+// infeasibility certificate: Solved for the first, NoSolution for the second, every time
+TEST(Lemke, PsdWithKnownSolutionOrCertificate) {
+  LemkeWorkspace ws;
+  for (std::uint32_t seed = 1; seed <= 12; ++seed) {
+    for (Index n : {15, 25, 35, 60}) {
+      for (Index r : {Index{1}, n / 3 + 1, n}) {
+        const std::string what = "seed " + std::to_string(seed) + " n " + std::to_string(n) + " rank " + std::to_string(r);
+        expectLemkeDecides(psdWithSolution(n, r, seed), true, ws, "known solution, " + what);
+        expectLemkeDecides(psdInfeasible(n, r, seed), false, ws, "certificate, " + what);
+      }
+    }
+  }
 }
 
 // contact-like M = J b⁻¹ Jᵀ (rank ≤ 42), exact PSD and regularised; always feasible

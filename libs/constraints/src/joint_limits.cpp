@@ -30,6 +30,10 @@ JointLimits::JointLimits(const skeleton::Model& model, JointLimitOptions options
     }
   }
   gamma_.resize(model.nv);
+  qdot_.resize(model.nv);
+  // at most two rows per coordinate: the lists never grow in the loop
+  candidates_.reserve(2 * coordinates_.size());
+  rows_.reserve(2 * coordinates_.size());
 }
 
 int JointLimits::activeCount() const {
@@ -61,7 +65,7 @@ lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
     if (std::isfinite(c.upper) && next > c.upper - options_.activation) candidates_.push_back({static_cast<int>(i), true});
   }
   if (candidates_.empty()) return lcp::LcpStatus::Solved;
-  lcp::LcpResult res;
+  lcp::LcpResult& res = result_;
   // the forces at the candidates move the other coordinates too (through b⁻¹): a coordinate they push
   // past its limit joins the candidates and the LCP is solved again (a few rounds at most)
   for (int round = 0;; ++round) {
@@ -79,15 +83,17 @@ lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
       const double d = upper ? c.upper - q(c.q) : q(c.q) - c.lower;
       problem_.q(r) = Jc_.row(r).dot(qdot_f) + std::max(d / dt, -options_.recovery_speed);
     }
-    BinvJcT_ = ctl.apparentFrictionLLT().solve(Jc_.transpose());  // b⁻¹ J_cᵀ
-    problem_.M = Jc_ * BinvJcT_;
-    res = lcp::solveLemke(problem_, workspace_);
+    BinvJcT_ = Jc_.transpose();
+    ctl.apparentFrictionLLT().solveInPlace(BinvJcT_);  // b⁻¹ J_cᵀ
+    problem_.M.noalias() = Jc_ * BinvJcT_;
+    lcp::solveLemke(problem_, workspace_, lcp::LemkeOptions{}, res);
     if (res.status != lcp::LcpStatus::Solved) {
       ++failures_;
       return res.status;
     }
     if (round >= options_.max_rounds) break;
-    qdot_ = qdot_f + BinvJcT_ * res.z;
+    qdot_ = qdot_f;
+    qdot_.noalias() += BinvJcT_ * res.z;
     bool grown = false;
     for (std::size_t i = 0; i < coordinates_.size(); ++i) {
       const Coordinate& c = coordinates_[i];

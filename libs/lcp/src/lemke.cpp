@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <utility>
 
 namespace mannequin::lcp {
 
@@ -29,6 +30,7 @@ struct LemkeSolver {
   const Eigen::MatrixXd& M;
   const Eigen::VectorXd& q;
   const LemkeOptions& opt;
+  double pivot_tolerance;  // opt's, or a retry's
   Index n;
   int z0;
   double scale = 1.0;
@@ -88,7 +90,7 @@ struct LemkeSolver {
   // lexicographic minimum ratio test on column c; −1 means no blocking row (a ray)
   Index ratioTest(Index c) {
     const auto col = ws.tableau_.col(c);
-    const double tol = opt.pivot_tolerance * std::max(col.cwiseAbs().maxCoeff(), scale);
+    const double tol = pivot_tolerance * std::max(col.cwiseAbs().maxCoeff(), scale);
     // minimum ratio over the blocking rows
     double best = std::numeric_limits<double>::infinity();
     for (Index i = 0; i < n; ++i) {
@@ -181,42 +183,53 @@ void finish(const LcpProblem& p, LcpResult& res) {
 
 namespace {
 
-// one complementary pivoting run with covering vector workspace.cover_ already set
-LcpResult lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace,
-                       const LemkeOptions& options);
+// one complementary pivoting run with covering vector workspace.cover_ already set and the given
+// pivot tolerance (the retries change it), written into res
+void lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace, const LemkeOptions& options,
+                  double pivot_tolerance, LcpResult& res);
+
+// an answer with no solution vectors (invalid input)
+LcpStatus invalid(LcpResult& res, const char* message) {
+  res.status = LcpStatus::Invalid;
+  res.message = message;
+  res.z.resize(0);
+  res.w.resize(0);
+  res.pivots = 0;
+  res.residuals = LcpResiduals{};
+  return res.status;
+}
 
 }  // namespace
 
 LcpResult solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace,
                      const LemkeOptions& options) {
   LcpResult res;
+  solveLemke(problem, workspace, options, res);
+  return res;
+}
+
+LcpStatus solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace, const LemkeOptions& options,
+                     LcpResult& res) {
   // input checks
-  if (const char* err = validate(problem)) {
-    res.status = LcpStatus::Invalid;
-    res.message = err;
-    return res;
-  }
+  if (const char* err = validate(problem)) return invalid(res, err);
   const Index n = problem.q.size();
   if (options.covering.size() != 0 &&
       (options.covering.size() != n || !options.covering.allFinite() ||
        options.covering.minCoeff() <= 0.0)) {
-    res.status = LcpStatus::Invalid;
-    res.message = "covering vector must have n finite positive entries";
-    return res;
+    return invalid(res, "covering vector must have n finite positive entries");
   }
   if (!(options.pivot_tolerance >= 0.0) || !(options.tie_tolerance >= 0.0) ||
       options.max_pivots < 0) {
-    res.status = LcpStatus::Invalid;
-    res.message = "negative tolerance or pivot limit";
-    return res;
+    return invalid(res, "negative tolerance or pivot limit");
   }
-  res.z.setZero(n);
   // trivial solution z = 0 when q ≥ 0
   if (n == 0 || problem.q.minCoeff() >= 0.0) {
+    res.z.setZero(n);
+    res.pivots = 0;
     res.status = LcpStatus::Solved;
     res.message = "q >= 0: z = 0";
     finish(problem, res);
-    return res;
+    return res.status;
   }
   workspace.resize(n);
   if (options.covering.size() == n) {
@@ -224,37 +237,37 @@ LcpResult solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace,
   } else {
     workspace.cover_.setOnes();
   }
-  res = lemkeAttempt(problem, workspace, options);
+  lemkeAttempt(problem, workspace, options, options.pivot_tolerance, res);
   // on rank-deficient M a near-singular basis can derail the path: retry with another
   // tolerance or along another path; a real ray comes back again and is reported
   int total = res.pivots;
   for (int k = 1; k <= options.retries && (res.status == LcpStatus::NoSolution ||
                                            res.status == LcpStatus::NumericalFailure); ++k) {
     // odd retries: another pivot tolerance on the same path; even ones: another path
-    LemkeOptions alt = options;
+    double pivot_tolerance = options.pivot_tolerance;
     if (k % 2 == 1) {
-      alt.pivot_tolerance = options.pivot_tolerance * (k == 1 ? 100.0 : 0.01);
+      pivot_tolerance *= k == 1 ? 100.0 : 0.01;
     } else {
       for (Index i = 0; i < n; ++i) {
         const double frac = std::fmod(0.6180339887498949 * static_cast<double>((i + 1) * (k + 1)), 1.0);
         workspace.cover_[i] = (options.covering.size() == n ? options.covering[i] : 1.0) * (0.5 + frac);
       }
     }
-    LcpResult retry = lemkeAttempt(problem, workspace, alt);
+    LcpResult& retry = workspace.retry_;
+    lemkeAttempt(problem, workspace, options, pivot_tolerance, retry);
     total += retry.pivots;
-    if (retry.status == LcpStatus::Solved || retry.status == res.status) res = std::move(retry);
+    if (retry.status == LcpStatus::Solved || retry.status == res.status) std::swap(res, retry);
   }
   res.pivots = total;
-  return res;
+  return res.status;
 }
 
 namespace {
 
-LcpResult lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace,
-                       const LemkeOptions& options) {
-  LcpResult res;
+void lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace, const LemkeOptions& options,
+                  double pivot_tolerance, LcpResult& res) {
   const Index n = problem.q.size();
-  LemkeSolver s{workspace, problem.M, problem.q, options, n, static_cast<int>(2 * n)};
+  LemkeSolver s{workspace, problem.M, problem.q, options, pivot_tolerance, n, static_cast<int>(2 * n)};
   s.scale = std::max(problem.M.cwiseAbs().maxCoeff(), workspace.cover_.maxCoeff());
   s.setup();
   const int max_pivots = options.max_pivots > 0 ? options.max_pivots
@@ -323,7 +336,6 @@ LcpResult lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace,
     res.status = LcpStatus::NumericalFailure;
     res.message = "final basis fails the residual check (ill-conditioned pivots)";
   }
-  return res;
 }
 
 }  // namespace

@@ -19,7 +19,8 @@
 /// The forces at the candidates move the other coordinates too (b⁻¹ couples them): a coordinate that
 /// q̇ = q̇_f + b⁻¹J_cᵀλ would carry past its limit joins the candidates and the LCP is solved again
 /// (at most `max_rounds` more times).
-/// Allocates per step in proportion to the number of candidates (none when no limit is near).
+/// Allocates nothing when no limit is near; with candidates, only when their number changes from the
+/// previous step (the LCP's matrices and Lemke's workspace are resized).
 #include <utility>
 #include <vector>
 
@@ -75,6 +76,7 @@ class JointLimits {
   std::vector<LimitRow> rows_;
   lcp::LemkeWorkspace workspace_;
   lcp::LcpProblem problem_;
+  lcp::LcpResult result_;
   Eigen::MatrixXd Jc_, BinvJcT_;
   Eigen::VectorXd gamma_;
   long failures_ = 0;

@@ -5,7 +5,8 @@
 ///
 /// Works on w − M z − d z₀ = q. The tableau only stores the n+1 non-basic columns
 /// (n×(n+1), dense, column-major) and is updated in place by a rank-one exchange at each
-/// pivot; nothing is allocated once the workspace has the right size. For a copositive-plus
+/// pivot; nothing is allocated once the workspace has the right size (the overload writing into a
+/// caller's LcpResult allocates nothing at all once it has run on size n). For a copositive-plus
 /// M (e.g. symmetric positive semidefinite) ray termination proves the LCP has no solution.
 #include <vector>
 
@@ -61,6 +62,7 @@ class LemkeWorkspace {
   std::vector<int> where_;     // 2n+1, row (≥ 0) or −(column+1) of each variable
   std::vector<int> ties_;      // candidate rows of the ratio test
   std::vector<int> keep_;      // scratch for the lexicographic filter
+  LcpResult retry_;            // result of a retry run (the in-place solve swaps it in)
 };
 
 /// Solves 0 ≤ M z + q ⊥ z ≥ 0 (M n×n, q n) by Lemke's method.
@@ -68,5 +70,11 @@ class LemkeWorkspace {
 /// non-positive covering vector) or NumericalFailure (final residual check failed).
 LcpResult solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace,
                      const LemkeOptions& options = {});
+
+/// Same, written into `result` and returning its status. No heap allocation once `result` and the
+/// workspace have held a problem of this size (options.covering empty or of size n): the form for a
+/// real-time loop.
+LcpStatus solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace, const LemkeOptions& options,
+                     LcpResult& result);
 
 }  // namespace mannequin::lcp
