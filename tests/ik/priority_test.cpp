@@ -1,6 +1,7 @@
 // The priority loop (paper eq. 3, 4, 6, 7, 8 and Annex) on random linear problems.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
 
 #include "mannequin/ik/priority.hpp"
@@ -48,6 +49,52 @@ TEST(DampedInverse, BoundsTheStepNearASingularity) {
   EXPECT_GT(n_plain, 1e5);
   EXPECT_LE(n_damped, dx.norm() / (2.0 * lambda) + 1e-12);
   EXPECT_LT(n_damped, 1e-3);  // σ/(σ²+λ²) = 1e-6/0.0025 = 4e-4
+}
+
+TEST(PriorityLoop, AlgorithmicSingularityTwoLevelsPullingTheSameWayIsBoundedByDamping) {
+  // Paper Fig. 4b: two levels whose rows tend to the same direction, J2 = cos ε J1 + sin ε w
+  // (w ⊥ J1, unit), each asking a different amount along it. J2 P_N(J1) = sin ε w: without
+  // damping level 2's contribution is r2 / sin ε (r2 = Δx2 − J2 Δθ1), unbounded as ε → 0 like
+  // 1/distance; with damping λ every level's contribution stays ≤ ‖its Δx‖ / (2λ) (Annex:
+  // σ/(σ²+λ²) ≤ 1/(2λ)), and level 1 is met either way.
+  std::mt19937 g(11);
+  const int n = 7;
+  VectorX j1 = randomVector(n, g);
+  j1.normalize();
+  VectorX w = randomVector(n, g);
+  w -= w.dot(j1) * j1;
+  w.normalize();
+  const double lambda = 0.1, dx1 = 0.3, dx2 = 0.5;
+  double previous = 0.0;
+  for (double eps : {1e-1, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6}) {
+    const MatrixX J1 = j1.transpose();
+    const MatrixX J2 = (std::cos(eps) * j1 + std::sin(eps) * w).transpose();
+    const VectorX x1 = VectorX::Constant(1, dx1), x2 = VectorX::Constant(1, dx2);
+    PriorityLoop plain(n), damped(n);
+    plain.solve({{J1, x1, 0.0}, {J2, x2, 0.0}});
+    damped.solve({{J1, x1, lambda}, {J2, x2, lambda}});
+    const double r2 = dx2 - std::cos(eps) * dx1;  // Δx2 − J2 Δθ1 with Δθ1 = J1⁺Δx1
+    const double c2_plain = plain.contributions().col(1).norm();
+    EXPECT_NEAR(c2_plain * std::sin(eps), r2, 1e-9 * r2) << "eps " << eps;  // = r2 / sin ε
+    if (previous > 0.0) {
+      EXPECT_GT(c2_plain, 9.0 * previous) << "eps " << eps;  // grows like 1/ε (×10 per decade)
+    }
+    previous = c2_plain;
+    // level 1 met up to the rounding of the huge plain step (its error grows with it)
+    EXPECT_LT((J1 * plain.dtheta() - x1).norm(), 1e-9 * (1.0 + plain.dtheta().norm())) << "eps " << eps;
+    EXPECT_LT((J1 * damped.dtheta() - x1).norm(), 1e-12 + lambda * lambda * dx1) << "eps " << eps;
+    // damped: each level's contribution within the Annex bound, for every ε
+    const VectorX& c1 = damped.contributions().col(0);
+    const VectorX& c2 = damped.contributions().col(1);
+    EXPECT_LE(c1.norm(), dx1 / (2.0 * lambda) + 1e-12) << "eps " << eps;
+    EXPECT_LE(c2.norm(), dx2 / (2.0 * lambda) + 1e-12) << "eps " << eps;
+    EXPECT_LE(c2.norm(), std::abs(dx2 - J2.row(0).dot(c1)) / (2.0 * lambda) + 1e-12) << "eps " << eps;
+    EXPECT_LT(damped.dtheta().norm(), (dx1 + dx2) / (2.0 * lambda)) << "eps " << eps;
+    // level 2 moves nothing of level 1 (strictness), damped or not
+    EXPECT_LT(std::abs(J1.row(0).dot(c2)), 1e-12) << "eps " << eps;
+    EXPECT_LT(std::abs(J1.row(0).dot(plain.contributions().col(1))), 1e-9 * c2_plain) << "eps " << eps;
+  }
+  EXPECT_GT(previous, 1e5);  // at ε = 1e-6 the plain contribution is ~2.1e5
 }
 
 TEST(PriorityLoop, TwoLevelsEqualHanafusaFormula) {

@@ -43,7 +43,7 @@ PriorityLoop::PriorityLoop(int n, PriorityOptions options) : n_(n), options_(opt
 }
 
 const VectorX& PriorityLoop::solve(const std::vector<LinearLevel>& levels, const VectorX* free,
-                                   const VectorX* dtheta0) {
+                                   const VectorX* dtheta0, const std::vector<LevelClamp>* clamps) {
   const double tol = options_.rank_tolerance;
   int total_rows = 0;
   for (std::size_t k = 0; k < levels.size(); ++k) {
@@ -62,6 +62,18 @@ const VectorX& PriorityLoop::solve(const std::vector<LinearLevel>& levels, const
   }
   if (free && free->size() != n_) throw std::invalid_argument("PriorityLoop: free mask has wrong size");
   if (dtheta0 && dtheta0->size() != n_) throw std::invalid_argument("PriorityLoop: Δθ_0 has wrong size");
+  const int p = static_cast<int>(levels.size());
+  int clamp_rows = 0;
+  if (clamps)
+    for (const auto& c : *clamps) {
+      if (c.coordinate < 0 || c.coordinate >= n_ || c.level < 1 || c.level >= p || !std::isfinite(c.dtheta))
+        throw std::invalid_argument("PriorityLoop: clamp of coordinate " + std::to_string(c.coordinate) +
+                                    " at level " + std::to_string(c.level + 1) + " is out of range (" +
+                                    std::to_string(n_) + " coordinates, levels 2.." + std::to_string(p) +
+                                    ") or not finite");
+      ++clamp_rows;
+    }
+  total_rows += clamp_rows;
 
   if (dtheta0) dtheta_ = *dtheta0;
   else dtheta_.setZero(n_);
@@ -81,6 +93,34 @@ const VectorX& PriorityLoop::solve(const std::vector<LinearLevel>& levels, const
   for (std::size_t k = 0; k < levels.size(); ++k) {
     const auto& L = levels[k];
     const int m = static_cast<int>(L.J.rows());
+    if (clamps) {
+      // coordinates held from this level on: rows e_iᵀΔθ = target, strictly above level k
+      int c = 0;
+      for (const auto& cl : *clamps) c += cl.level == static_cast<int>(k);
+      if (c > 0) {
+        E_.setZero(c, n_);
+        rE_.resize(c);
+        int row = 0;
+        for (const auto& cl : *clamps) {
+          if (cl.level != static_cast<int>(k)) continue;
+          E_(row, cl.coordinate) = 1.0;
+          rE_(row) = cl.dtheta - dtheta_(cl.coordinate);
+          ++row;
+        }
+        Jhat_.noalias() = E_ * P_;
+        Eigen::JacobiSVD<MatrixX> svd(Jhat_.transpose(), Eigen::ComputeThinU | Eigen::ComputeThinV);
+        const int r = applyInverse(svd, rE_, 0.0, tol, w_, step);
+        dtheta_ += step;
+        C_.col(static_cast<Eigen::Index>(k)) += step;
+        if (!full) {
+          if (r > 0) P_.noalias() -= svd.matrixU().leftCols(r) * svd.matrixU().leftCols(r).transpose();
+        } else {
+          JA_.middleRows(rows, c) = E_;
+          rows += c;
+          fullProjector(rows);
+        }
+      }
+    }
     if (m == 0) continue;
     Jhat_.noalias() = L.J * P_;
     r_ = L.dx;
@@ -103,7 +143,7 @@ const VectorX& PriorityLoop::solve(const std::vector<LinearLevel>& levels, const
       const double smax = step.lpNorm<Eigen::Infinity>();
       if (smax > options_.max_step) step *= options_.max_step / smax;
       dtheta_ += step;
-      C_.col(static_cast<Eigen::Index>(k)) = step;
+      C_.col(static_cast<Eigen::Index>(k)) += step;
       continue;
     }
     Eigen::JacobiSVD<MatrixX> svd(Jhat_.transpose(), Eigen::ComputeThinU | Eigen::ComputeThinV);
@@ -111,7 +151,7 @@ const VectorX& PriorityLoop::solve(const std::vector<LinearLevel>& levels, const
     const double smax = step.lpNorm<Eigen::Infinity>();
     if (smax > options_.max_step) step *= options_.max_step / smax;
     dtheta_ += step;
-    C_.col(static_cast<Eigen::Index>(k)) = step;
+    C_.col(static_cast<Eigen::Index>(k)) += step;
     if (!full) {
       // (8): P_k = P_{k−1} − Ĵ^+Ĵ, and Ĵ^+Ĵ = U_r U_rᵀ (row space of Ĵ)
       const int r = ranks_[k];
@@ -120,16 +160,20 @@ const VectorX& PriorityLoop::solve(const std::vector<LinearLevel>& levels, const
       // (7): P_k = P_0 − (J^A P_0)^+ (J^A P_0), recomputed from the augmented Jacobian
       JA_.middleRows(rows, m) = L.J;
       rows += m;
-      JAhat_.noalias() = JA_.topRows(rows) * P0_;
-      Eigen::JacobiSVD<MatrixX> svdA(JAhat_.transpose(), Eigen::ComputeThinU);
-      const auto& s = svdA.singularValues();
-      int r = 0;
-      while (r < s.size() && s(r) > tol) ++r;
-      P_ = P0_;
-      if (r > 0) P_.noalias() -= svdA.matrixU().leftCols(r) * svdA.matrixU().leftCols(r).transpose();
+      fullProjector(rows);
     }
   }
   return dtheta_;
+}
+
+void PriorityLoop::fullProjector(int rows) {
+  JAhat_.noalias() = JA_.topRows(rows) * P0_;
+  Eigen::JacobiSVD<MatrixX> svdA(JAhat_.transpose(), Eigen::ComputeThinU);
+  const auto& s = svdA.singularValues();
+  int r = 0;
+  while (r < s.size() && s(r) > options_.rank_tolerance) ++r;
+  P_ = P0_;
+  if (r > 0) P_.noalias() -= svdA.matrixU().leftCols(r) * svdA.matrixU().leftCols(r).transpose();
 }
 
 MatrixX dampedInverse(const MatrixX& J, double lambda, double rank_tolerance) {

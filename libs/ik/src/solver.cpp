@@ -31,14 +31,19 @@ IkSolver::IkSolver(const Model& model, SolverOptions options)
       options_(options),
       data_(model),
       ctx_(model, data_),
-      loop_(model.nv, PriorityOptions{options.update, options.rank_tolerance, options.step_limits.joint}) {
+      loop_(model.nv, PriorityOptions{options.update, options.rank_tolerance, options.step_limits.joint}),
+      correction_loop_(model.nv, loop_.options()) {
   if (options.max_iterations < 0) throw std::invalid_argument("IkSolver: max_iterations must be >= 0");
   if (!(options.min_step >= 0.0)) throw std::invalid_argument("IkSolver: min_step must be >= 0");
   if (!(options.step_limits.linear > 0.0) || !(options.step_limits.angular > 0.0) ||
       !(options.step_limits.joint > 0.0))
     throw std::invalid_argument("IkSolver: step limits must be > 0");
-  free_ = VectorX::Ones(model.nv);
-  dtheta0_ = VectorX::Zero(model.nv);
+  for (ClampState* c : {&clamp_, &correction_clamp_}) {
+    c->free = VectorX::Ones(model.nv);
+    c->dtheta0 = VectorX::Zero(model.nv);
+    c->partial = VectorX::Zero(model.nv);
+    c->level.assign(static_cast<std::size_t>(model.nv), -1);
+  }
   lower_ = model.lower_limit;
   upper_ = model.upper_limit;
   for (const auto& joint : model.joints) {
@@ -138,31 +143,67 @@ void IkSolver::linearise(const VectorX& q, bool limit_steps, SolveReport* report
 }
 
 namespace {
-// Clamping loop around the priority loop; returns passes beyond the first.
+// Clamping loop around the priority loop; returns passes beyond the first. A limited coordinate
+// is clamped at the first level k whose partial solution Δθ_k (every level above included) takes
+// it past a limit: held at the limit from level k on (k = 0: P_0 and Δθ_0, the paper's clamping;
+// k > 0: a LevelClamp), so the levels above k keep it and the backtracking scales the clamp with
+// level k. Clamps only move up a level or get added, so the loop ends.
 int clampingLoop(PriorityLoop& loop, const std::vector<LinearLevel>& levels, const VectorX& q,
                  const std::vector<int>& limited, const VectorX& lower, const VectorX& upper, bool limits,
-                 VectorX& free, VectorX& dtheta0, int* clamped) {
+                 IkSolver::ClampState& state, int* clamped) {
+  VectorX& free = state.free;
+  VectorX& dtheta0 = state.dtheta0;
+  VectorX& partial = state.partial;
+  std::vector<int>& clamp_level = state.level;
+  std::vector<LevelClamp>& clamps = state.clamps;
   free.setOnes();
   dtheta0.setZero();
+  clamps.clear();
+  std::fill(clamp_level.begin(), clamp_level.end(), -1);
   int passes = 0;
   *clamped = 0;
-  const int max_passes = static_cast<int>(limited.size()) + 1;
+  const int p = static_cast<int>(levels.size());
+  const int max_passes = static_cast<int>(limited.size()) * std::max(p, 1) + 1;
   for (int pass = 0; pass < max_passes; ++pass) {
-    const VectorX& d = loop.solve(levels, &free, &dtheta0);
+    loop.solve(levels, &free, &dtheta0, &clamps);
     if (!limits) break;
+    const MatrixX& C = loop.contributions();
     bool violation = false;
     for (int i : limited) {
-      if (free(i) == 0.0) continue;
-      const double next = q(i) + d(i);
-      constexpr double eps = 1e-12;
-      if (next > upper(i) + eps || next < lower(i) - eps) {
-        free(i) = 0.0;
-        dtheta0(i) = (next > upper(i) ? upper(i) : lower(i)) - q(i);
-        ++*clamped;
-        violation = true;
+      const int current = clamp_level[i] < 0 ? p : clamp_level[i];
+      partial(i) = dtheta0(i);
+      for (int k = 0; k < current; ++k) {
+        partial(i) += C(i, k);
+        const double next = q(i) + partial(i);
+        constexpr double eps = 1e-12;
+        if (next > upper(i) + eps || next < lower(i) - eps) {
+          const double target = (next > upper(i) ? upper(i) : lower(i)) - q(i);
+          if (clamp_level[i] < 0) ++*clamped;
+          clamp_level[i] = k;
+          if (k == 0) {
+            free(i) = 0.0;
+            dtheta0(i) = target;
+          } else {
+            bool found = false;
+            for (auto& c : clamps)
+              if (c.coordinate == i) {
+                c.level = k;
+                c.dtheta = target;
+                found = true;
+              }
+            if (!found) clamps.push_back(LevelClamp{i, k, target});
+          }
+          violation = true;
+          break;
+        }
       }
     }
-    if (!violation) break;
+    if (violation) {
+      // a coordinate moved to level 0 leaves the per-level list
+      std::erase_if(clamps, [&](const LevelClamp& c) { return clamp_level[c.coordinate] == 0; });
+    } else {
+      break;
+    }
     ++passes;
   }
   return passes;
@@ -173,7 +214,7 @@ const VectorX& IkSolver::step(const VectorX& q) {
   checkConfiguration(q);
   linearise(q, true, nullptr);
   int clamped = 0;
-  clampingLoop(loop_, linear_, q, limited_, lower_, upper_, options_.joint_limits, free_, dtheta0_, &clamped);
+  clampingLoop(loop_, linear_, q, limited_, lower_, upper_, options_.joint_limits, clamp_, &clamped);
   return loop_.dtheta();
 }
 
@@ -210,10 +251,30 @@ SolveReport IkSolver::evaluate(const VectorX& q) {
   return report;
 }
 
+int IkSolver::firstDamaged(const SolveReport& before, const SolveReport& trial, const VectorX& alpha) const {
+  const int p = levelCount();
+  for (int k = 0; k < p; ++k) {
+    bool lower = false;
+    for (int j = k + 1; j < p; ++j) lower = lower || alpha(j) > 0.0;
+    if (!lower) return -1;  // damage from its own or higher levels' steps is not a priority violation
+    const double b = before.levels[k].residual;
+    const double allowed = std::max(b, before.levels[k].tolerance);
+    if (trial.levels[k].residual > allowed + 1e-12 * (1.0 + b)) return k;
+  }
+  return -1;
+}
+
+VectorX IkSolver::applyWithinLimits(const VectorX& q, const VectorX& dtheta) const {
+  VectorX out = apply(q, dtheta);
+  if (options_.joint_limits)
+    for (int i : limited_) out(i) = std::clamp(out(i), lower_(i), upper_(i));
+  return out;
+}
+
 SolveReport IkSolver::solve(VectorX& q) {
   checkConfiguration(q);
   VectorX qk = q;
-  SolveReport report, trial;
+  SolveReport report, trial, corrected;
   linearise(qk, true, &report);
   const int p = levelCount();
   VectorX alpha(p), d(model_.nv);
@@ -229,31 +290,38 @@ SolveReport IkSolver::solve(VectorX& q) {
       break;
     }
     int clamped = 0;
-    report.clamping_passes += clampingLoop(loop_, linear_, qk, limited_, lower_, upper_, options_.joint_limits, free_,
-                                           dtheta0_, &clamped);
+    report.clamping_passes +=
+        clampingLoop(loop_, linear_, qk, limited_, lower_, upper_, options_.joint_limits, clamp_, &clamped);
     report.clamped = clamped;
     for (int k = 0; k < p; ++k) report.levels[k].rank = loop_.ranks()[k];
     const MatrixX& C = loop_.contributions();
-    // lexicographic backtracking on the level contributions
+    // lexicographic backtracking on the level contributions, with a second-order correction
     alpha.setOnes();
     bool accepted = false;
     for (;;) {
-      d = dtheta0_;
+      d = clamp_.dtheta0;
       d.noalias() += C * alpha;
       if (d.lpNorm<Eigen::Infinity>() < options_.min_step) break;
-      VectorX q_try = apply(qk, d);
-      if (options_.joint_limits)
-        for (int i : limited_) q_try(i) = std::clamp(q_try(i), lower_(i), upper_(i));
+      VectorX q_try = applyWithinLimits(qk, d);
       linearise(q_try, true, &trial);
       // first level made worse while lower levels still contribute: those lower levels did it
-      int damaged = -1;
-      for (int k = 0; k < p && damaged < 0; ++k) {
-        bool lower = false;
-        for (int j = k + 1; j < p; ++j) lower = lower || alpha(j) > 0.0;
-        if (!lower) break;  // damage from its own or higher levels' steps is not a priority violation
-        const double before = report.levels[k].residual;
-        const double allowed = std::max(before, report.levels[k].tolerance);
-        if (trial.levels[k].residual > allowed + 1e-12 * (1.0 + before)) damaged = k;
+      int damaged = firstDamaged(report, trial, alpha);
+      if (damaged >= 0 && options_.correction) {
+        // the damage is second order: levels 0..damaged alone, re-linearised at q_try, take
+        // their own targets back (one Gauss-Newton step of the higher levels, clamping included)
+        head_.assign(linear_.begin(), linear_.begin() + damaged + 1);
+        int c = 0;
+        clampingLoop(correction_loop_, head_, q_try, limited_, lower_, upper_, options_.joint_limits,
+                     correction_clamp_, &c);
+        VectorX q_corr = applyWithinLimits(q_try, correction_loop_.dtheta());
+        linearise(q_corr, true, &corrected);
+        ++report.corrections;
+        const int still = firstDamaged(report, corrected, alpha);
+        if (still < 0) {
+          q_try = std::move(q_corr);
+          std::swap(trial, corrected);
+        }
+        damaged = still;
       }
       if (damaged < 0) {
         accepted = true;

@@ -53,6 +53,18 @@ struct PriorityOptions {
   double max_step = std::numeric_limits<double>::infinity();
 };
 
+/// A coordinate held at a given variation from one level on (the clamping loop's joint limits,
+/// solver.hpp): the levels above `level` use the coordinate freely; then the row
+/// e_iᵀ Δθ = dtheta is solved with strict priority just above `level` (plain pseudo-inverse in
+/// the null space of the higher levels) and taken out of the projector for `level` and below.
+/// Its contribution counts in column `level` of contributions(). Levels are 0-based; a clamp for
+/// every level is P_0 = diag(free) with Δθ_0 instead, so here 1 ≤ level < p.
+struct LevelClamp {
+  int coordinate = 0;
+  int level = 1;
+  double dtheta = 0.0;
+};
+
 /// Reusable priority loop for n coordinates. Allocates its workspace on first use of each
 /// level size; solve() is allocation-free once the sizes have been seen.
 class PriorityLoop {
@@ -61,11 +73,12 @@ class PriorityLoop {
 
   /// Runs the loop. \param free optional (n) mask: 1 = coordinate takes part, 0 = clamped
   /// (P_0 = diag(free)); nullptr = all free. \param dtheta0 optional (n) Δθ_0 (the variations
-  /// imposed on clamped coordinates); nullptr = 0. \returns Δθ_p (n).
-  /// \throws std::invalid_argument on inconsistent sizes, a negative or NaN damping, or a
-  /// non-finite J or Δx (naming the level).
+  /// imposed on clamped coordinates); nullptr = 0. \param clamps optional coordinates held from
+  /// a lower level on (LevelClamp). \returns Δθ_p (n).
+  /// \throws std::invalid_argument on inconsistent sizes, a negative or NaN damping, a
+  /// non-finite J or Δx (naming the level), or a clamp out of range.
   const VectorX& solve(const std::vector<LinearLevel>& levels, const VectorX* free = nullptr,
-                       const VectorX* dtheta0 = nullptr);
+                       const VectorX* dtheta0 = nullptr, const std::vector<LevelClamp>* clamps = nullptr);
 
   int size() const { return n_; }
   const PriorityOptions& options() const { return options_; }
@@ -77,16 +90,19 @@ class PriorityLoop {
   const MatrixX& projector() const { return P_; }
   const std::vector<int>& ranks() const { return ranks_; }
   /// After solve(): the contribution of each level, column k = Δθ_k − Δθ_{k−1} (n × p), so that
-  /// Δθ_p = Δθ_0 + Σ_k column k. Scaling the columns of the levels below some level i keeps every
-  /// level ≤ i unchanged to first order (the convergence loop's backtracking uses this).
+  /// Δθ_p = Δθ_0 + Σ_k column k (a LevelClamp's contribution is in its level's column). Scaling
+  /// the columns of the levels below some level i keeps every level ≤ i unchanged to first order
+  /// (the convergence loop's backtracking uses this).
   const MatrixX& contributions() const { return C_; }
 
  private:
+  void fullProjector(int rows);  ///< (7) from the first `rows` rows of JA_
+
   int n_;
   PriorityOptions options_;
   VectorX dtheta_;
-  MatrixX P_, P0_, Jhat_, JA_, JAhat_, U_, tmp_;
-  VectorX r_, sigma_, w_;
+  MatrixX P_, P0_, Jhat_, JA_, JAhat_, U_, tmp_, E_;
+  VectorX r_, sigma_, w_, rE_;
   std::vector<int> ranks_;
   MatrixX C_;
 };

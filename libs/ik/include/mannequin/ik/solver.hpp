@@ -42,6 +42,9 @@ struct SolverOptions {
   StepLimits step_limits;        ///< error asked per iteration
   bool joint_limits = true;      ///< clamping loop on model.lower_limit/upper_limit
   int max_backtracks = 12;       ///< halvings of a level's contribution before it is dropped
+  /// Before halving, re-solve the damaged level and those above it at the trial point and check
+  /// again (second-order correction, docs/ik.md).
+  bool correction = true;
 };
 
 enum class StopReason { kAllSatisfied, kStalled, kMaxIterations };
@@ -68,6 +71,7 @@ struct SolveReport {
   int clamping_passes = 0;     ///< extra priority loops run by the clamping loop, all iterations
   int clamped = 0;             ///< coordinates at a limit after the last iteration's clamping
   int backtracks = 0;          ///< halvings of level contributions, all iterations
+  int corrections = 0;         ///< second-order corrections tried, all iterations
   std::vector<LevelReport> levels;
   std::vector<TaskReport> tasks;
   bool allSatisfied() const;
@@ -110,12 +114,22 @@ class IkSolver {
   const std::vector<LinearLevel>& linearLevels() const { return linear_; }
   const PriorityLoop& priorityLoop() const { return loop_; }
 
+  /// The clamping loop's state (solver.cpp): P_0 mask and Δθ_0 for the coordinates clamped for
+  /// every level, the first level each coordinate is clamped at (−1: free), the other clamps.
+  struct ClampState {
+    VectorX free, dtheta0, partial;
+    std::vector<int> level;
+    std::vector<LevelClamp> clamps;
+  };
+
  private:
   struct Level {
     LevelOptions options;
     std::vector<std::unique_ptr<Task>> tasks;
   };
   void linearise(const VectorX& q, bool limit_steps, SolveReport* report);
+  int firstDamaged(const SolveReport& before, const SolveReport& trial, const VectorX& alpha) const;
+  VectorX applyWithinLimits(const VectorX& q, const VectorX& dtheta) const;
   void checkConfiguration(const VectorX& q) const;
 
   const Model& model_;
@@ -125,7 +139,10 @@ class IkSolver {
   std::vector<Level> levels_;
   std::vector<LinearLevel> linear_;
   PriorityLoop loop_;
-  VectorX free_, dtheta0_, lower_, upper_;
+  ClampState clamp_, correction_clamp_;
+  PriorityLoop correction_loop_;
+  std::vector<LinearLevel> head_;  ///< the levels a correction re-solves
+  VectorX lower_, upper_;
   std::vector<int> limited_;  ///< coordinates with at least one finite limit (never the root)
 };
 
