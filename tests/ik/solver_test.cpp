@@ -243,8 +243,8 @@ struct Fig8 {
     foot_r = d.oMf[model.frameIndex("sole_r")];
     support = 0.5 * (foot_l.p + foot_r.p);
   }
-  SolveReport run(bool with_com, VectorX& q, Vector3* com = nullptr, bool single = false) {
-    IkSolver s(model, [] { SolverOptions o; o.max_iterations = 300; return o; }());
+  SolveReport run(bool with_com, VectorX& q, Vector3* com = nullptr, bool single = false, int progress_window = 20) {
+    IkSolver s(model, [&] { SolverOptions o; o.max_iterations = 300; o.progress_window = progress_window; return o; }());
     int level = 0;
     if (with_com) {
       s.addLevel({"balance", 0.0, 1e-4});
@@ -283,6 +283,9 @@ TEST(Fig8, ComStaysAboveTheSupportWhileHandsReachAsFarAsItAllows) {
   // clamps caused by the hands were imposed on every level and exempt from backtracking)
   EXPECT_LE(bal.levels[1].residual, 1e-5);
   EXPECT_TRUE(bal.levels[1].satisfied);
+  // the solve converged (the unreachable hands stopped improving), it did not run out of iterations
+  EXPECT_EQ(bal.stop, StopReason::kConverged) << toString(bal.stop) << " after " << bal.iterations;
+  EXPECT_LT(bal.iterations, 300);
   // hands: unreachable, as close as the balance allows (worse than without it)
   const double hands_bal = bal.levels[2].residual, hands_free = fre.levels[1].residual;
   EXPECT_FALSE(bal.levels[2].satisfied);
@@ -323,6 +326,8 @@ TEST(Fig8, SingleSupportComOverTheSupportFootFootFixed) {
   EXPECT_LE(r.levels[1].residual, 1e-5);  // the support foot: strict, at its tolerance
   EXPECT_LT((d.oMf[f.model.frameIndex("sole_l")].p - f.foot_l.p).norm(), 1e-5);
   EXPECT_FALSE(r.levels[2].satisfied);  // unreachable hands
+  EXPECT_EQ(r.stop, StopReason::kConverged) << toString(r.stop) << " after " << r.iterations;
+  EXPECT_LT(r.iterations, 300);
   for (int i = 6; i < f.model.nq; ++i) {
     EXPECT_GE(q(i), f.model.lower_limit(i) - 1e-9);
     EXPECT_LE(q(i), f.model.upper_limit(i) + 1e-9);
@@ -330,6 +335,36 @@ TEST(Fig8, SingleSupportComOverTheSupportFootFootFixed) {
   std::printf("Fig8 single support: CoM offset %.2e m, foot %.2e, hands %.3f m, iterations %d, backtracks %d, "
               "corrections %d, stop %s\n", (com - f.foot_l.p).head<2>().norm(), r.levels[1].residual,
               r.levels[2].residual, r.iterations, r.backtracks, r.corrections, toString(r.stop));
+}
+
+TEST(Fig8, ConvergenceStopsOnTheResidualPlateau) {
+  // the progress test ends the solve once the unreachable hands improve by less than 1e-4 of their
+  // residual in 20 iterations; without it the loop runs to max_iterations. Both keep the strict
+  // levels (CoM, feet) at their tolerance: stopping early never trades a higher level.
+  Fig8 f;
+  for (bool single : {false, true}) {
+    VectorX q_stop, q_long;
+    const SolveReport stop = f.run(true, q_stop, nullptr, single);
+    const SolveReport longer = f.run(true, q_long, nullptr, single, /*progress_window=*/0);
+    ASSERT_EQ(stop.stop, StopReason::kConverged) << (single ? "single" : "double") << " support";
+    EXPECT_EQ(longer.stop, StopReason::kMaxIterations);
+    EXPECT_LT(stop.iterations, longer.iterations);
+    for (const SolveReport* r : {&stop, &longer}) {
+      EXPECT_TRUE(r->levels[0].satisfied);
+      EXPECT_LE(r->levels[1].residual, 1e-5);
+      EXPECT_FALSE(r->levels[2].satisfied);
+    }
+    std::printf("Fig8 %s support: converged after %d iterations (hands %.6f m); %d iterations without the "
+                "progress test (hands %.6f m)\n", single ? "single" : "double", stop.iterations,
+                stop.levels[2].residual, longer.iterations, longer.levels[2].residual);
+  }
+}
+
+TEST(IkSolver, RefusesANegativeProgressTolerance) {
+  const Model model = skeleton::buildMannequin(skeleton::loadMannequinSpec(sourceDir() + "/configs/mannequins/male_50th.yaml"));
+  SolverOptions o;
+  o.progress_tolerance = -1.0;
+  EXPECT_THROW(IkSolver(model, o), std::invalid_argument);
 }
 
 }  // namespace

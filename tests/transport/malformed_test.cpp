@@ -2,6 +2,8 @@
 // schema versions, NaN poses. All counted, none reaches a handler, good messages still flow.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <random>
 
@@ -139,25 +141,42 @@ TEST(Malformed, WrongFramingIsCounted) {
   zmq::socket_t raw(ctx, zmq::socket_type::pub);
   raw.bind(dir.ipc("raw"));
   Subscriber sub(ctx, {"victim", {dir.ipc("raw")}});
-  Counts counts;
-  subscribeAll(sub, counts);
-  const std::string good = goodFrame(1).SerializeAsString();
-  // the raw socket has no late-joiner resend: repeat until the subscription is in place
-  for (int k = 0; k < 1000 && counts.calls == 0; ++k) {
-    auto f = goodFrame(k + 1).SerializeAsString();
+  std::vector<std::uint64_t> seen;  // header sequence of every delivered mocap.frame
+  sub.subscribe(topics::kMocapFrame,
+                std::function<void(const v1::MocapFrame&)>([&seen](const v1::MocapFrame& f) { seen.push_back(f.header().sequence()); }),
+                validateMocapFrame);
+  auto sendFrame = [&raw](std::uint64_t seq) {
     (void)raw.send(zmq::buffer(std::string("mocap.frame")), zmq::send_flags::sndmore);
-    (void)raw.send(zmq::buffer(f), zmq::send_flags::none);
+    (void)raw.send(zmq::buffer(goodFrame(seq).SerializeAsString()), zmq::send_flags::none);
+  };
+  auto waitFor = [&](std::uint64_t seq) {
+    const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+    while (std::find(seen.begin(), seen.end(), seq) == seen.end()) {
+      if (std::chrono::steady_clock::now() > deadline) return false;
+      sub.poll(std::chrono::milliseconds(5));
+    }
+    return true;
+  };
+  // the raw socket has no late-joiner resend: probe (sequences 1..999) until the subscription is in place
+  bool joined = false;
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(20);
+  for (std::uint64_t k = 1; k < 1000 && !joined && std::chrono::steady_clock::now() < deadline; ++k) {
+    sendFrame(k);
     sub.poll(std::chrono::milliseconds(2));
+    joined = !seen.empty();
   }
-  ASSERT_GE(counts.calls, 1);
-  const int before = counts.calls;
-  (void)raw.send(zmq::buffer(std::string("mocap.frame")), zmq::send_flags::none);  // one part only
-  (void)raw.send(zmq::buffer(std::string("mocap.frame")), zmq::send_flags::sndmore);  // three parts
-  (void)raw.send(zmq::buffer(good), zmq::send_flags::sndmore);
-  (void)raw.send(zmq::buffer(good), zmq::send_flags::none);
-  for (int k = 0; k < 100 && sub.badFraming() < 2; ++k) sub.poll(std::chrono::milliseconds(2));
+  ASSERT_TRUE(joined) << "no probe frame reached the subscriber within 20 s";
+  // bad framing: one part only, then three parts whose payload is a valid frame (sequence 500000)
+  const std::string framed = goodFrame(500000).SerializeAsString();
+  (void)raw.send(zmq::buffer(std::string("mocap.frame")), zmq::send_flags::none);
+  (void)raw.send(zmq::buffer(std::string("mocap.frame")), zmq::send_flags::sndmore);
+  (void)raw.send(zmq::buffer(framed), zmq::send_flags::sndmore);
+  (void)raw.send(zmq::buffer(framed), zmq::send_flags::none);
+  // a good frame after them: once it is delivered, both bad messages have been read (one socket, in order)
+  sendFrame(1000000);
+  ASSERT_TRUE(waitFor(1000000)) << "the good frame sent after the bad framing was not delivered within 20 s";
   EXPECT_EQ(sub.badFraming(), 2u);
-  EXPECT_EQ(counts.calls, before);
+  EXPECT_EQ(std::count(seen.begin(), seen.end(), 500000u), 0) << "the three-part message reached the handler";
 }
 
 TEST(Malformed, AThrowingHandlerIsCaughtAndCounted) {

@@ -15,6 +15,7 @@ const char* toString(StopReason r) {
   switch (r) {
     case StopReason::kAllSatisfied: return "all_satisfied";
     case StopReason::kStalled: return "stalled";
+    case StopReason::kConverged: return "converged";
     case StopReason::kMaxIterations: return "max_iterations";
   }
   return "?";
@@ -35,6 +36,8 @@ IkSolver::IkSolver(const Model& model, SolverOptions options)
       correction_loop_(model.nv, loop_.options()) {
   if (options.max_iterations < 0) throw std::invalid_argument("IkSolver: max_iterations must be >= 0");
   if (!(options.min_step >= 0.0)) throw std::invalid_argument("IkSolver: min_step must be >= 0");
+  if (!(options.progress_tolerance >= 0.0) || options.progress_window < 0)
+    throw std::invalid_argument("IkSolver: progress_window and progress_tolerance must be >= 0");
   if (!(options.step_limits.linear > 0.0) || !(options.step_limits.angular > 0.0) ||
       !(options.step_limits.joint > 0.0))
     throw std::invalid_argument("IkSolver: step limits must be > 0");
@@ -278,12 +281,40 @@ SolveReport IkSolver::solve(VectorX& q) {
   linearise(qk, true, &report);
   const int p = levelCount();
   VectorX alpha(p), d(model_.nv);
+  // residuals and satisfied flags of every level, one row per iteration (progress test)
+  const int window = std::max(options_.progress_window, 0);
+  std::vector<double> history;
+  std::vector<char> satisfied_history;
+  if (window > 0) {
+    history.reserve(static_cast<std::size_t>(p) * (options_.max_iterations + 1));
+    satisfied_history.reserve(history.capacity());
+  }
   for (int it = 0;; ++it) {
     for (auto& l : report.levels)
       if (l.satisfied && l.satisfied_at < 0) l.satisfied_at = it;
     if (report.allSatisfied()) {
       report.stop = StopReason::kAllSatisfied;
       break;
+    }
+    if (window > 0) {
+      for (const auto& l : report.levels) {
+        history.push_back(l.residual);
+        satisfied_history.push_back(l.satisfied ? 1 : 0);
+      }
+      if (it >= window) {
+        // compare with the row `window` iterations ago
+        const std::size_t then = static_cast<std::size_t>(it - window) * p, now = static_cast<std::size_t>(it) * p;
+        bool progress = false;
+        for (int k = 0; k < p && !progress; ++k) {
+          if (satisfied_history[then + k] && !satisfied_history[now + k]) progress = true;  // lost: not converged
+          if (satisfied_history[now + k]) continue;
+          progress = history[then + k] - history[now + k] > options_.progress_tolerance * history[then + k];
+        }
+        if (!progress) {
+          report.stop = StopReason::kConverged;
+          break;
+        }
+      }
     }
     if (it >= options_.max_iterations) {
       report.stop = StopReason::kMaxIterations;

@@ -45,9 +45,17 @@ struct SolverOptions {
   /// Before halving, re-solve the damaged level and those above it at the trial point and check
   /// again (second-order correction, docs/ik.md).
   bool correction = true;
+  /// Converged when, over the last progress_window iterations, no unsatisfied level's residual fell
+  /// by more than progress_tolerance × its residual at the window's start, and no satisfied level
+  /// was lost (the lower levels are as close as the higher ones allow; the posture may still drift
+  /// in the remaining null space). 0 disables the test.
+  int progress_window = 20;
+  double progress_tolerance = 1e-4;
 };
 
-enum class StopReason { kAllSatisfied, kStalled, kMaxIterations };
+/// Why the convergence loop stopped: every level satisfied; the step vanished (‖Δθ‖∞ < min_step)
+/// or no step was accepted; the residuals stopped improving (progress_window); max_iterations.
+enum class StopReason { kAllSatisfied, kStalled, kConverged, kMaxIterations };
 const char* toString(StopReason r);
 
 struct TaskReport {
