@@ -5,6 +5,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <chrono>
 #include <cstdio>
 #include <filesystem>
@@ -57,16 +58,34 @@ services:
                                        "test.yaml", dir);
   SupervisorOptions o;
   o.exec_dir = MANNEQUIN_BIN_DIR;
-  o.duration = 1.5;
+  o.duration = 0;  // until `stop`: set once what the test checks has happened (no fixed window)
   o.status_period = 0.5;
   char* buffer = nullptr;
   std::size_t size = 0;
   std::FILE* out = open_memstream(&buffer, &size);
   o.out = out;
   Supervisor sup(d, o);
-  std::atomic<bool> stop{false};
+  std::atomic<bool> stop{false}, timed_out{false};
+  std::thread watcher([&] {
+    // at least 1.5 s (status lines), 5 heartbeats of mocap and 'broken' failed for good; 60 s at most
+    const auto start = std::chrono::steady_clock::now();
+    for (;;) {
+      const auto st = sup.status();
+      const bool done = st.size() == 2 && st[0].heartbeats >= 5 && st[1].state == ServiceState::kFailed;
+      const auto elapsed = std::chrono::steady_clock::now() - start;
+      if (done && elapsed >= std::chrono::milliseconds(1500)) break;
+      if (elapsed > std::chrono::seconds(60)) {
+        timed_out = true;
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+    stop = true;
+  });
   const int rc = sup.run(stop);
+  watcher.join();
   std::fclose(out);
+  ASSERT_FALSE(timed_out) << "within 60 s: mocap did not send 5 heartbeats or 'broken' did not fail permanently";
   const std::string text(buffer, size);
   free(buffer);
 

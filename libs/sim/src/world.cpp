@@ -18,7 +18,7 @@ struct World::Mannequin {
   int root_frame = -1;
   std::vector<int> frame_indices;
   std::unique_ptr<Stepper> stepper;
-  std::vector<ControlFrameStatus> frames;
+  std::vector<DrivenFrame> frames;
   std::vector<math::SE3> previous_targets;  // targets of the previous step (target twist)
   std::vector<bool> have_previous;
   std::vector<double> weights;  // current weights (rate-limited)
@@ -38,7 +38,7 @@ World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : conf
     m->root_frame = m->model.findFrame(s.root_frame);
     std::vector<int> idx;
     for (const ControlFrameSpec& f : s.frames) {
-      ControlFrameStatus st;
+      DrivenFrame st;
       st.frame = f.frame;
       st.body = f.body;
       try {
@@ -78,7 +78,7 @@ const skeleton::VectorX& World::q(int m) const { return mannequins_.at(m)->stepp
 const skeleton::VectorX& World::qdot(int m) const { return mannequins_.at(m)->stepper->qdot(); }
 bool World::calibrated(int m) const { return mannequins_.at(m)->calibrated; }
 const Stepper& World::stepper(int m) const { return *mannequins_.at(m)->stepper; }
-const std::vector<ControlFrameStatus>& World::controlFrames(int m) const { return mannequins_.at(m)->frames; }
+const std::vector<DrivenFrame>& World::controlFrames(int m) const { return mannequins_.at(m)->frames; }
 
 void World::anchor(std::int64_t capture_ns) {
   anchored_ = true;
@@ -177,7 +177,7 @@ bool World::step() {
     Mannequin& m = *mp;
     if (m.calibrated && anchored_) {
       for (std::size_t i = 0; i < m.frames.size(); ++i) {
-        ControlFrameStatus& st = m.frames[i];
+        DrivenFrame& st = m.frames[i];
         const BodySample s = buffer_.sample(st.body, t);
         double goal = 1.0;
         if (s.tracked) {
@@ -206,7 +206,7 @@ bool World::step() {
     }
     const skeleton::Data& d = m.stepper->data();
     for (std::size_t i = 0; i < m.frames.size(); ++i) {
-      ControlFrameStatus& st = m.frames[i];
+      DrivenFrame& st = m.frames[i];
       st.actual = d.oMf[st.frame_index];
       st.weight = m.weights[i];
       st.position_error = (st.target.p - st.actual.p).norm();

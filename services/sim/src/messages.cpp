@@ -39,7 +39,7 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
       toMsg(d.oMi[s.joint], *np->mutable_pose());
     }
     toMsg(d.com, *ms->mutable_com());
-    for (const sim::ControlFrameStatus& st : world.controlFrames(i)) {
+    for (const sim::DrivenFrame& st : world.controlFrames(i)) {
       v1::ControlFrameState* c = ms->add_control_frames();
       c->set_frame(st.frame);
       c->set_body(st.body);

@@ -72,8 +72,11 @@ struct SimConfig {
   std::optional<constraints::JointLimitOptions> joint_limits = constraints::JointLimitOptions{};
 };
 
-/// State of one control frame after a step.
-struct ControlFrameStatus {
+/// A control frame driven by a mocap body, after a step: the World's calibration (bMf), the target it
+/// derives from the body, and how well the mannequin follows it. The controller's coupling on the same
+/// frame (gains, wrench, port energy) is control::ControlFrameState. The wire's v1::ControlFrameState is
+/// filled from this.
+struct DrivenFrame {
   std::string frame, body;
   int frame_index = -1;
   math::SE3 offset;         ///< bMf from calibration
@@ -114,7 +117,7 @@ class World {
   bool calibrated(int m) const;
   /// The mannequin's stepper (kind(), and for a ControllerStepper its controller).
   const Stepper& stepper(int m) const;
-  const std::vector<ControlFrameStatus>& controlFrames(int m) const;
+  const std::vector<DrivenFrame>& controlFrames(int m) const;
   /// The newest mocap frame added (nullptr before any).
   const mocap::Frame* latestMocap() const { return buffer_.newest(); }
   std::uint64_t failedSteps() const { return failed_steps_; }
