@@ -103,3 +103,57 @@ TEST(Allocation, PgsAndStructuredDoNotAllocatePerStep) {
   EXPECT_GE(p30, p3);
   EXPECT_LE(p30 - p3, 2);  // a converged sweep may build w once for its residual check
 }
+
+// the capacity path: reserved once for the largest size, then problems of varying n (blocks of
+// capacity-sized buffers) allocate nothing and answer as the allocating forms do
+TEST(Allocation, CapacityPathVaryingSizeAllocatesNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "malloc is owned by AddressSanitizer";
+#endif
+  const Index cap = 50;
+  const auto c = gen::makeContactLike(cap, 5);  // A cap×m, M = A Aᵀ
+  const Index m = c.A.cols();
+  LemkeWorkspace lw;
+  PgsWorkspace pw;
+  StructuredWorkspace sw;
+  lw.reserve(cap);
+  pw.reserve(cap);
+  sw.reserve(cap, m);
+  LcpResult r;
+  r.reserve(cap);
+  PgsOptions po;
+  po.max_iterations = 20000;
+  StructuredOptions so;
+  so.warm_start = false;
+  for (const Index n : {Index{50}, Index{7}, Index{31}, Index{2}, Index{50}, Index{19}}) {
+    const auto M = c.lcp.M.topLeftCorner(n, n);
+    const auto q = c.lcp.q.head(n);
+    LcpStatus ls = LcpStatus::Invalid, ps = LcpStatus::Invalid, ss = LcpStatus::Invalid;
+    Eigen::VectorXd zl, zp, zs;
+    const long allocations = countAllocations([&] {
+      const NoEigenMalloc no_eigen_malloc;
+      ls = solveLemke(M, q, lw, LemkeOptions{}, r);
+    });
+    zl = r.z.head(n);
+    const long pgs_allocations = countAllocations([&] { ps = solvePgs(M, q, pw, po, r); });
+    zp = r.z.head(n);
+    const long structured_allocations = countAllocations([&] { ss = solveStructured(c.A.topRows(n), q, sw, so, r); });
+    zs = r.z.head(n);
+    EXPECT_EQ(allocations, 0) << "n = " << n;
+    EXPECT_EQ(pgs_allocations, 0) << "n = " << n;
+    EXPECT_EQ(structured_allocations, 0) << "n = " << n;
+    ASSERT_EQ(ls, LcpStatus::Solved) << n;
+    ASSERT_EQ(ss, LcpStatus::Solved) << n;
+    // the allocating form on a copy of the block gives the same z
+    const LcpProblem copy{M, q};
+    LemkeWorkspace fresh_ws;
+    const LcpResult fresh = solveLemke(copy, fresh_ws);
+    EXPECT_EQ((fresh.z - zl).lpNorm<Eigen::Infinity>(), 0.0) << n;
+    // w = Mz + q is unique for PSD M: all three agree on it
+    const Eigen::VectorXd wl = M * zl + q, ws = M * zs + q;
+    EXPECT_LT((wl - ws).lpNorm<Eigen::Infinity>(), 1e-7) << n;
+    if (ps == LcpStatus::Solved) {
+      EXPECT_LT((wl - (M * zp + q)).lpNorm<Eigen::Infinity>(), 1e-6) << n;
+    }
+  }
+}

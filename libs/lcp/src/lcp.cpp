@@ -16,16 +16,17 @@ const char* statusName(LcpStatus status) {
   return "invalid";
 }
 
-const char* validate(const LcpProblem& problem) {
-  if (problem.M.rows() != problem.M.cols()) return "M is not square";
-  if (problem.q.size() != problem.M.rows()) return "q and M sizes differ";
-  if (!problem.M.allFinite()) return "M has a NaN or Inf entry";
-  if (!problem.q.allFinite()) return "q has a NaN or Inf entry";
+const char* validate(const LcpProblem& problem) { return validate(problem.M, problem.q); }
+
+const char* validate(const MatrixView& M, const VectorView& q) {
+  if (M.rows() != M.cols()) return "M is not square";
+  if (q.size() != M.rows()) return "q and M sizes differ";
+  if (!M.allFinite()) return "M has a NaN or Inf entry";
+  if (!q.allFinite()) return "q has a NaN or Inf entry";
   return nullptr;
 }
 
-LcpResiduals computeResiduals(const Eigen::VectorXd& q, const Eigen::VectorXd& z,
-                              const Eigen::VectorXd& w) {
+LcpResiduals computeResiduals(const VectorView& q, const VectorView& z, const VectorView& w) {
   LcpResiduals r;
   const Index n = z.size();
   if (n == 0) return r;

@@ -7,32 +7,48 @@
 
 namespace mannequin::lcp {
 
+void LemkeWorkspace::reserve(Index capacity) {
+  if (capacity <= capacity_) return;
+  capacity_ = capacity;
+  tableau_.resize(capacity, capacity + 1);
+  rhs_.resize(capacity);
+  col_.resize(capacity);
+  row_.resize(capacity + 1);
+  cover_.resize(capacity);
+  resid_.resize(capacity);
+  delta_.resize(capacity);
+  basic_.reserve(static_cast<std::size_t>(capacity));
+  nonbasic_.reserve(static_cast<std::size_t>(capacity + 1));
+  where_.reserve(static_cast<std::size_t>(2 * capacity + 1));
+  ties_.reserve(static_cast<std::size_t>(capacity));
+  keep_.reserve(static_cast<std::size_t>(capacity));
+  retry_.reserve(capacity);
+}
+
 void LemkeWorkspace::resize(Index n) {
   if (n == n_) return;
+  reserve(n);
   n_ = n;
-  tableau_.resize(n, n + 1);
-  rhs_.resize(n);
-  col_.resize(n);
-  row_.resize(n + 1);
-  cover_.resize(n);
-  resid_.resize(n);
-  delta_.resize(n);
   basic_.assign(static_cast<std::size_t>(n), 0);
   nonbasic_.assign(static_cast<std::size_t>(n + 1), 0);
   where_.assign(static_cast<std::size_t>(2 * n + 1), 0);
-  ties_.reserve(static_cast<std::size_t>(n));
-  keep_.reserve(static_cast<std::size_t>(n));
 }
 
 // the pivoting engine; variables are numbered w_i = i, z_i = n + i, z0 = 2n
 struct LemkeSolver {
+  using Tableau = Eigen::Block<Eigen::MatrixXd>;
+  using Segment = Eigen::VectorBlock<Eigen::VectorXd>;
   LemkeWorkspace& ws;
-  const Eigen::MatrixXd& M;
-  const Eigen::VectorXd& q;
+  const MatrixView& M;
+  const VectorView& q;
   const LemkeOptions& opt;
   double pivot_tolerance;  // opt's, or a retry's
   Index n;
   int z0;
+  // the leading blocks of the workspace's capacity-sized buffers
+  Tableau T{ws.tableau_, 0, 0, n, n + 1};
+  Segment rhs{ws.rhs_, 0, n}, col{ws.col_, 0, n}, row{ws.row_, 0, n + 1}, cover{ws.cover_, 0, n},
+      resid{ws.resid_, 0, n}, delta{ws.delta_, 0, n};
   double scale = 1.0;
   double min_rel_pivot = 1.0;  // smallest |pivot| / ‖column‖∞ met on the path
 
@@ -42,14 +58,14 @@ struct LemkeSolver {
   double binv(Index i, Index j) const {
     const int pos = ws.where_[u(j)];
     if (pos >= 0) return pos == i ? 1.0 : 0.0;
-    return ws.tableau_(i, -pos - 1);
+    return T(i, -pos - 1);
   }
 
   // fresh tableau: basis w, non-basic columns z (−M) then z0 (−d)
   void setup() {
-    ws.tableau_.leftCols(n) = -M;
-    ws.tableau_.col(n) = -ws.cover_;
-    ws.rhs_ = q;
+    T.leftCols(n) = -M;
+    T.col(n) = -cover;
+    rhs = q;
     for (Index i = 0; i < n; ++i) {
       ws.basic_[u(i)] = static_cast<int>(i);
       ws.where_[u(i)] = static_cast<int>(i);
@@ -63,21 +79,20 @@ struct LemkeSolver {
   // Jordan exchange on (r, c), in place: the entering variable of column c becomes basic in
   // row r and the leaving one takes column c
   void pivot(Index r, Index c) {
-    Eigen::MatrixXd& T = ws.tableau_;
     const double piv = T(r, c);
-    ws.col_ = T.col(c);
-    ws.row_ = T.row(r).transpose() / piv;
-    ws.col_[r] = 0.0;
+    col = T.col(c);
+    row = T.row(r).transpose() / piv;
+    col[r] = 0.0;
     // rank-one update of every other row
-    T.noalias() -= ws.col_ * ws.row_.transpose();
-    T.row(r) = ws.row_.transpose();
+    T.noalias() -= col * row.transpose();
+    T.row(r) = row.transpose();
     // the leaving variable's column
-    T.col(c) = ws.col_ / (-piv);
+    T.col(c) = col / (-piv);
     T(r, c) = 1.0 / piv;
     // basic values
-    const double xr = ws.rhs_[r] / piv;
-    ws.rhs_.noalias() -= xr * ws.col_;
-    ws.rhs_[r] = xr;
+    const double xr = rhs[r] / piv;
+    rhs.noalias() -= xr * col;
+    rhs[r] = xr;
     // bookkeeping
     const int entering = ws.nonbasic_[u(c)];
     const int leaving = ws.basic_[u(r)];
@@ -89,20 +104,20 @@ struct LemkeSolver {
 
   // lexicographic minimum ratio test on column c; −1 means no blocking row (a ray)
   Index ratioTest(Index c) {
-    const auto col = ws.tableau_.col(c);
-    const double tol = pivot_tolerance * std::max(col.cwiseAbs().maxCoeff(), scale);
+    const auto column = T.col(c);
+    const double tol = pivot_tolerance * std::max(column.cwiseAbs().maxCoeff(), scale);
     // minimum ratio over the blocking rows
     double best = std::numeric_limits<double>::infinity();
     for (Index i = 0; i < n; ++i) {
-      if (col[i] > tol) best = std::min(best, std::max(ws.rhs_[i], 0.0) / col[i]);
+      if (column[i] > tol) best = std::min(best, std::max(rhs[i], 0.0) / column[i]);
     }
     if (!std::isfinite(best)) return -1;
-    const double colmax = col.cwiseAbs().maxCoeff();
+    const double colmax = column.cwiseAbs().maxCoeff();
     // rows tied with it; z0 leaving ends the solve, so it wins any tie
     const double tie = best + opt.tie_tolerance * std::max(1.0, best);
     ws.ties_.clear();
     for (Index i = 0; i < n; ++i) {
-      if (col[i] > tol && std::max(ws.rhs_[i], 0.0) / col[i] <= tie) {
+      if (column[i] > tol && std::max(rhs[i], 0.0) / column[i] <= tie) {
         if (ws.basic_[u(i)] == z0) return i;
         ws.ties_.push_back(static_cast<int>(i));
       }
@@ -117,86 +132,148 @@ struct LemkeSolver {
         continue;
       }
       double vmin = std::numeric_limits<double>::infinity();
-      for (int i : ws.ties_) vmin = std::min(vmin, binv(i, j) / col[i]);
+      for (int i : ws.ties_) vmin = std::min(vmin, binv(i, j) / column[i]);
       const double vtol = opt.tie_tolerance * std::max(1.0, std::abs(vmin));
       ws.keep_.clear();
       for (int i : ws.ties_) {
-        if (binv(i, j) / col[i] <= vmin + vtol) ws.keep_.push_back(i);
+        if (binv(i, j) / column[i] <= vmin + vtol) ws.keep_.push_back(i);
       }
       ws.ties_.swap(ws.keep_);
     }
     // numerically indistinguishable rows left: take the largest pivot
     Index r = ws.ties_.front();
     for (int i : ws.ties_) {
-      if (col[i] > col[r]) r = i;
+      if (column[i] > column[r]) r = i;
     }
-    min_rel_pivot = std::min(min_rel_pivot, col[r] / colmax);
+    min_rel_pivot = std::min(min_rel_pivot, column[r] / colmax);
     return r;
   }
 
   // one step of iterative refinement of the basic values: rhs += B⁻¹ (q − B rhs)
   void refine() {
-    ws.resid_ = q;
+    resid = q;
     for (Index i = 0; i < n; ++i) {
       const int v = ws.basic_[u(i)];
       if (v < n) {
-        ws.resid_[v] -= ws.rhs_[i];
+        resid[v] -= rhs[i];
       } else if (v < 2 * n) {
-        ws.resid_.noalias() += M.col(v - n) * ws.rhs_[i];
+        resid.noalias() += M.col(v - n) * rhs[i];
       } else {
-        ws.resid_.noalias() += ws.cover_ * ws.rhs_[i];
+        resid.noalias() += cover * rhs[i];
       }
     }
-    ws.delta_.setZero();
+    delta.setZero();
     for (Index j = 0; j < n; ++j) {
       const int pos = ws.where_[u(j)];
       if (pos >= 0) {
-        ws.delta_[pos] += ws.resid_[j];
+        delta[pos] += resid[j];
       } else {
-        ws.delta_.noalias() += ws.tableau_.col(-pos - 1) * ws.resid_[j];
+        delta.noalias() += T.col(-pos - 1) * resid[j];
       }
     }
-    ws.rhs_ += ws.delta_;
+    rhs += delta;
   }
 
   // z from the basic values, clamped at 0
-  void extract(Eigen::VectorXd& z) const {
-    z.setZero(n);
+  void extract(Segment z) const {
+    z.setZero();
     for (Index i = 0; i < n; ++i) {
       const int v = ws.basic_[u(i)];
-      if (v >= n && v < 2 * n) z[v - n] = std::max(0.0, ws.rhs_[i]);
+      if (v >= n && v < 2 * n) z[v - n] = std::max(0.0, rhs[i]);
     }
   }
 };
 
 namespace {
 
-// fills w = Mz + q and the residuals; keeps everything finite
-void finish(const LcpProblem& p, LcpResult& res) {
-  if (!res.z.allFinite()) res.z.setZero(p.q.size());
-  res.w.noalias() = p.M * res.z;
-  res.w += p.q;
-  res.residuals = computeResiduals(p.q, res.z, res.w);
+// fills w = Mz + q and the residuals of z, w (n-entry views); keeps everything finite
+void finish(const MatrixView& M, const VectorView& q, Eigen::VectorBlock<Eigen::VectorXd> z,
+            Eigen::VectorBlock<Eigen::VectorXd> w, LcpResult& res) {
+  if (!z.allFinite()) z.setZero();
+  w.noalias() = M * z;
+  w += q;
+  res.residuals = computeResiduals(q, z, w);
 }
 
-}  // namespace
-
-namespace {
-
 // one complementary pivoting run with covering vector workspace.cover_ already set and the given
-// pivot tolerance (the retries change it), written into res
-void lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace, const LemkeOptions& options,
-                  double pivot_tolerance, LcpResult& res);
+// pivot tolerance (the retries change it), written into the first n entries of res.z, res.w
+void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+                  const LemkeOptions& options, double pivot_tolerance, LcpResult& res);
 
 // an answer with no solution vectors (invalid input)
 LcpStatus invalid(LcpResult& res, const char* message) {
   res.status = LcpStatus::Invalid;
   res.message = message;
-  res.z.resize(0);
-  res.w.resize(0);
   res.pivots = 0;
   res.residuals = LcpResiduals{};
   return res.status;
+}
+
+// the solve on views, into the first n entries of res.z, res.w (at least n entries each)
+LcpStatus solveViews(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+                     const LemkeOptions& options, LcpResult& res) {
+  const Index n = q.size();
+  // trivial solution z = 0 when q ≥ 0
+  if (n == 0 || q.minCoeff() >= 0.0) {
+    res.z.head(n).setZero();
+    res.pivots = 0;
+    res.status = LcpStatus::Solved;
+    res.message = "q >= 0: z = 0";
+    finish(M, q, res.z.head(n), res.w.head(n), res);
+    return res.status;
+  }
+  workspace.resize(n);
+  auto cover = workspace.cover_.head(n);
+  if (options.covering.size() == n) {
+    cover = options.covering;
+  } else {
+    cover.setOnes();
+  }
+  lemkeAttempt(M, q, workspace, options, options.pivot_tolerance, res);
+  // on rank-deficient M a near-singular basis can derail the path: retry with another
+  // tolerance or along another path; a real ray comes back again and is reported
+  int total = res.pivots;
+  for (int k = 1; k <= options.retries && (res.status == LcpStatus::NoSolution ||
+                                           res.status == LcpStatus::NumericalFailure); ++k) {
+    // odd retries: another pivot tolerance on the same path; even ones: another path
+    double pivot_tolerance = options.pivot_tolerance;
+    if (k % 2 == 1) {
+      pivot_tolerance *= k == 1 ? 100.0 : 0.01;
+    } else {
+      for (Index i = 0; i < n; ++i) {
+        const double frac = std::fmod(0.6180339887498949 * static_cast<double>((i + 1) * (k + 1)), 1.0);
+        cover[i] = (options.covering.size() == n ? options.covering[i] : 1.0) * (0.5 + frac);
+      }
+    }
+    LcpResult& retry = workspace.retry_;
+    retry.reserve(n);
+    lemkeAttempt(M, q, workspace, options, pivot_tolerance, retry);
+    total += retry.pivots;
+    if (retry.status == LcpStatus::Solved || retry.status == res.status) {
+      // copy (not swap): res keeps its own storage
+      res.status = retry.status;
+      res.message = retry.message;
+      res.residuals = retry.residuals;
+      res.z.head(n) = retry.z.head(n);
+      res.w.head(n) = retry.w.head(n);
+    }
+  }
+  res.pivots = total;
+  return res.status;
+}
+
+// checks the options against n; nullptr when valid
+const char* checkOptions(const LemkeOptions& options, Index n) {
+  if (options.covering.size() != 0 &&
+      (options.covering.size() != n || !options.covering.allFinite() ||
+       options.covering.minCoeff() <= 0.0)) {
+    return "covering vector must have n finite positive entries";
+  }
+  if (!(options.pivot_tolerance >= 0.0) || !(options.tie_tolerance >= 0.0) ||
+      options.max_pivots < 0) {
+    return "negative tolerance or pivot limit";
+  }
+  return nullptr;
 }
 
 }  // namespace
@@ -210,65 +287,39 @@ LcpResult solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace,
 
 LcpStatus solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace, const LemkeOptions& options,
                      LcpResult& res) {
-  // input checks
-  if (const char* err = validate(problem)) return invalid(res, err);
+  const char* err = validate(problem);
+  if (err == nullptr) err = checkOptions(options, problem.q.size());
+  if (err != nullptr) {
+    res.z.resize(0);
+    res.w.resize(0);
+    return invalid(res, err);
+  }
   const Index n = problem.q.size();
-  if (options.covering.size() != 0 &&
-      (options.covering.size() != n || !options.covering.allFinite() ||
-       options.covering.minCoeff() <= 0.0)) {
-    return invalid(res, "covering vector must have n finite positive entries");
+  res.z.resize(n);
+  res.w.resize(n);
+  return solveViews(problem.M, problem.q, workspace, options, res);
+}
+
+LcpStatus solveLemke(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+                     const LemkeOptions& options, LcpResult& result) {
+  const char* err = validate(M, q);
+  if (err == nullptr) err = checkOptions(options, q.size());
+  if (err == nullptr && (result.z.size() < q.size() || result.w.size() < q.size())) {
+    err = "result.z and result.w need at least n entries (LcpResult::reserve)";
   }
-  if (!(options.pivot_tolerance >= 0.0) || !(options.tie_tolerance >= 0.0) ||
-      options.max_pivots < 0) {
-    return invalid(res, "negative tolerance or pivot limit");
-  }
-  // trivial solution z = 0 when q ≥ 0
-  if (n == 0 || problem.q.minCoeff() >= 0.0) {
-    res.z.setZero(n);
-    res.pivots = 0;
-    res.status = LcpStatus::Solved;
-    res.message = "q >= 0: z = 0";
-    finish(problem, res);
-    return res.status;
-  }
-  workspace.resize(n);
-  if (options.covering.size() == n) {
-    workspace.cover_ = options.covering;
-  } else {
-    workspace.cover_.setOnes();
-  }
-  lemkeAttempt(problem, workspace, options, options.pivot_tolerance, res);
-  // on rank-deficient M a near-singular basis can derail the path: retry with another
-  // tolerance or along another path; a real ray comes back again and is reported
-  int total = res.pivots;
-  for (int k = 1; k <= options.retries && (res.status == LcpStatus::NoSolution ||
-                                           res.status == LcpStatus::NumericalFailure); ++k) {
-    // odd retries: another pivot tolerance on the same path; even ones: another path
-    double pivot_tolerance = options.pivot_tolerance;
-    if (k % 2 == 1) {
-      pivot_tolerance *= k == 1 ? 100.0 : 0.01;
-    } else {
-      for (Index i = 0; i < n; ++i) {
-        const double frac = std::fmod(0.6180339887498949 * static_cast<double>((i + 1) * (k + 1)), 1.0);
-        workspace.cover_[i] = (options.covering.size() == n ? options.covering[i] : 1.0) * (0.5 + frac);
-      }
-    }
-    LcpResult& retry = workspace.retry_;
-    lemkeAttempt(problem, workspace, options, pivot_tolerance, retry);
-    total += retry.pivots;
-    if (retry.status == LcpStatus::Solved || retry.status == res.status) std::swap(res, retry);
-  }
-  res.pivots = total;
-  return res.status;
+  if (err != nullptr) return invalid(result, err);
+  return solveViews(M, q, workspace, options, result);
 }
 
 namespace {
 
-void lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace, const LemkeOptions& options,
-                  double pivot_tolerance, LcpResult& res) {
-  const Index n = problem.q.size();
-  LemkeSolver s{workspace, problem.M, problem.q, options, pivot_tolerance, n, static_cast<int>(2 * n)};
-  s.scale = std::max(problem.M.cwiseAbs().maxCoeff(), workspace.cover_.maxCoeff());
+void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+                  const LemkeOptions& options, double pivot_tolerance, LcpResult& res) {
+  const Index n = q.size();
+  LemkeSolver s{workspace, M, q, options, pivot_tolerance, n, static_cast<int>(2 * n)};
+  auto z = res.z.head(n);
+  auto w = res.w.head(n);
+  s.scale = std::max(M.cwiseAbs().maxCoeff(), s.cover.maxCoeff());
   s.setup();
   const int max_pivots = options.max_pivots > 0 ? options.max_pivots
                                                 : static_cast<int>(100 * n + 1000);
@@ -277,7 +328,7 @@ void lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace, const Le
   Index r = 0;
   double best = std::numeric_limits<double>::infinity();
   for (Index i = 0; i < n; ++i) {
-    const double ratio = problem.q[i] / workspace.cover_[i];
+    const double ratio = q[i] / s.cover[i];
     if (ratio <= best) {
       best = ratio;
       r = i;
@@ -296,10 +347,10 @@ void lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace, const Le
     r = s.ratioTest(c);
     if (r < 0) {
       // a degenerate ray met with z0 already at 0 still ends on a complementary solution
-      const double z0_value = workspace.rhs_[workspace.where_[static_cast<std::size_t>(s.z0)]];
-      if (z0_value <= options.tie_tolerance * (1.0 + problem.q.lpNorm<Eigen::Infinity>())) {
-        s.extract(res.z);
-        finish(problem, res);
+      const double z0_value = s.rhs[workspace.where_[static_cast<std::size_t>(s.z0)]];
+      if (z0_value <= options.tie_tolerance * (1.0 + q.lpNorm<Eigen::Infinity>())) {
+        s.extract(z);
+        finish(M, q, z, w, res);
         if (isComplementary(res.residuals, options.check_tolerance)) {
           res.status = LcpStatus::Solved;
           res.message = "solved (z0 reached 0 on a degenerate ray)";
@@ -330,8 +381,8 @@ void lemkeAttempt(const LcpProblem& problem, LemkeWorkspace& workspace, const Le
   if (res.status == LcpStatus::Solved) {
     for (int k = 0; k < options.refinement_steps; ++k) s.refine();
   }
-  s.extract(res.z);
-  finish(problem, res);
+  s.extract(z);
+  finish(M, q, z, w, res);
   if (res.status == LcpStatus::Solved && !isComplementary(res.residuals, options.check_tolerance)) {
     res.status = LcpStatus::NumericalFailure;
     res.message = "final basis fails the residual check (ill-conditioned pivots)";

@@ -25,7 +25,7 @@ void givens(double a, double b, double& c, double& s) {
 }
 
 // J ← J Gᵀ on columns (j, k)
-void rotateColumns(Eigen::MatrixXd& J, Index j, Index k, double c, double s) {
+void rotateColumns(Eigen::Block<Eigen::MatrixXd>& J, Index j, Index k, double c, double s) {
   for (Index i = 0; i < J.rows(); ++i) {
     const double a = J(i, j), b = J(i, k);
     J(i, j) = c * a + s * b;
@@ -35,10 +35,11 @@ void rotateColumns(Eigen::MatrixXd& J, Index j, Index k, double c, double s) {
 
 }  // namespace
 
-void StructuredWorkspace::resize(Index n, Index m) {
-  if (n == n_ && m == m_) return;
-  n_ = n;
-  m_ = m;
+void StructuredWorkspace::reserve(Index n_capacity, Index m_capacity) {
+  if (n_capacity <= n_cap_ && m_capacity <= m_cap_) return;
+  n_cap_ = std::max(n_cap_, n_capacity);
+  m_cap_ = std::max(m_cap_, m_capacity);
+  const Index n = n_cap_, m = m_cap_;
   J_.resize(m, m);
   R_.resize(m, m);
   x_.resize(m);
@@ -50,41 +51,63 @@ void StructuredWorkspace::resize(Index n, Index m) {
   as_.resize(n);
   norms_.resize(n);
   active_.reserve(u(m));
-  previous_.clear();
   previous_.reserve(u(m));
+  is_active_.reserve(u(n));
+  hinted_.reserve(u(n));
+}
+
+void StructuredWorkspace::resize(Index n, Index m) {
+  if (n == n_ && m == m_) return;
+  reserve(n, m);
+  n_ = n;
+  m_ = m;
+  previous_.clear();
   is_active_.assign(u(n), 0);
   hinted_.assign(u(n), 0);
 }
 
-LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace& ws,
-                          const StructuredOptions& options) {
-  LcpResult res;
-  // input checks
-  const Index n = problem.A.rows();
-  const Index m = problem.A.cols();
-  if (problem.q.size() != n) {
-    res.status = LcpStatus::Invalid;
-    res.message = "q and A row counts differ";
-    return res;
-  }
-  if (!problem.A.allFinite() || !problem.q.allFinite()) {
-    res.status = LcpStatus::Invalid;
-    res.message = "A or q has a NaN or Inf entry";
-    return res;
-  }
+namespace {
+
+LcpStatus fail(LcpResult& res, const char* message) {
+  res.status = LcpStatus::Invalid;
+  res.message = message;
+  res.pivots = 0;
+  res.residuals = LcpResiduals{};
+  return res.status;
+}
+
+const char* check(const MatrixView& A, const VectorView& q, const StructuredOptions& options) {
+  if (q.size() != A.rows()) return "q and A row counts differ";
+  if (!A.allFinite() || !q.allFinite()) return "A or q has a NaN or Inf entry";
   if (options.max_iterations < 0 || !(options.dependence_tolerance >= 0.0) ||
       !(options.feasibility_tolerance >= 0.0)) {
-    res.status = LcpStatus::Invalid;
-    res.message = "negative tolerance or iteration limit";
-    return res;
+    return "negative tolerance or iteration limit";
   }
+  return nullptr;
+}
+
+// the dual active-set method on views, into the first n entries of res.z, res.w
+LcpStatus solveViews(const MatrixView& A, const VectorView& q, StructuredWorkspace& ws,
+                     const StructuredOptions& options, LcpResult& res) {
+  const Index n = A.rows();
+  const Index m = A.cols();
   ws.resize(n, m);
+  auto J = ws.J_.topLeftCorner(m, m);
+  auto R = ws.R_.topLeftCorner(m, m);
+  auto x = ws.x_.head(m);
+  auto s = ws.s_.head(n);
+  auto dir = ws.dir_.head(m);
+  auto dvec = ws.d_.head(m);
+  auto rvec = ws.r_.head(m);
+  auto uvec = ws.u_.head(m);
+  auto as = ws.as_.head(n);
+  auto norms = ws.norms_.head(n);
   const bool warm = options.warm_start;
   // start at the unconstrained minimum x = 0 with nothing active
-  ws.J_.setIdentity();
-  ws.x_.setZero();
-  ws.s_ = problem.q;
-  ws.norms_ = problem.A.rowwise().norm();
+  J.setIdentity();
+  x.setZero();
+  s = q;
+  norms = A.rowwise().norm();
   std::fill(ws.is_active_.begin(), ws.is_active_.end(), 0);
   std::fill(ws.hinted_.begin(), ws.hinted_.end(), 0);
   if (warm) {
@@ -92,7 +115,7 @@ LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace&
   }
   ws.active_.clear();
   Index na = 0;
-  const double feas = options.feasibility_tolerance * (1.0 + problem.q.lpNorm<Eigen::Infinity>());
+  const double feas = options.feasibility_tolerance * (1.0 + q.lpNorm<Eigen::Infinity>());
   const int max_iter = options.max_iterations > 0 ? options.max_iterations
                                                   : static_cast<int>(10 * (n + m) + 100);
   const double inf = std::numeric_limits<double>::infinity();
@@ -104,21 +127,21 @@ LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace&
   auto drop = [&](Index k) {
     ws.is_active_[u(ws.active_[u(k)])] = 0;
     for (Index j = k; j + 1 < na; ++j) {
-      ws.R_.col(j).head(na) = ws.R_.col(j + 1).head(na);
+      R.col(j).head(na) = R.col(j + 1).head(na);
       ws.active_[u(j)] = ws.active_[u(j + 1)];
-      ws.u_[j] = ws.u_[j + 1];
+      uvec[j] = uvec[j + 1];
     }
     ws.active_.pop_back();
     for (Index j = k; j + 1 < na; ++j) {
-      double c, s;
-      givens(ws.R_(j, j), ws.R_(j + 1, j), c, s);
+      double c, sn;
+      givens(R(j, j), R(j + 1, j), c, sn);
       for (Index cc = j; cc + 1 < na; ++cc) {
-        const double a = ws.R_(j, cc), b = ws.R_(j + 1, cc);
-        ws.R_(j, cc) = c * a + s * b;
-        ws.R_(j + 1, cc) = -s * a + c * b;
+        const double a = R(j, cc), b = R(j + 1, cc);
+        R(j, cc) = c * a + sn * b;
+        R(j + 1, cc) = -sn * a + c * b;
       }
-      ws.R_(j + 1, j) = 0.0;
-      rotateColumns(ws.J_, j, j + 1, c, s);
+      R(j + 1, j) = 0.0;
+      rotateColumns(J, j, j + 1, c, sn);
     }
     --na;
   };
@@ -131,13 +154,13 @@ LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace&
       double worst = 0.0;
       for (Index i = 0; i < n; ++i) {
         if (ws.is_active_[u(i)] || (pass == 0 && !ws.hinted_[u(i)])) continue;
-        if (ws.s_[i] < -feas && ws.norms_[i] > 0.0) {
-          const double v = ws.s_[i] / ws.norms_[i];
+        if (s[i] < -feas && norms[i] > 0.0) {
+          const double v = s[i] / norms[i];
           if (v < worst) {
             worst = v;
             p = i;
           }
-        } else if (ws.s_[i] < -feas) {
+        } else if (s[i] < -feas) {
           p = i;  // zero row with q_i < 0: infeasible, caught below
           break;
         }
@@ -145,8 +168,8 @@ LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace&
     }
     if (p < 0) break;
     double u_new = 0.0;
-    const auto ap = problem.A.row(p).transpose();
-    const double ap_norm = ws.norms_[p];
+    const auto ap = A.row(p).transpose();
+    const double ap_norm = norms[p];
     // steps towards satisfying row p
     for (;;) {
       if (++iter > max_iter) {
@@ -155,28 +178,28 @@ LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace&
         done = true;
         break;
       }
-      ws.d_.noalias() = ws.J_.transpose() * ap;
+      dvec.noalias() = J.transpose() * ap;
       const Index free = m - na;
-      const double d2 = free > 0 ? ws.d_.tail(free).norm() : 0.0;
+      const double d2 = free > 0 ? dvec.tail(free).norm() : 0.0;
       const bool dependent = d2 <= options.dependence_tolerance * ap_norm;
-      if (!dependent) ws.dir_.noalias() = ws.J_.rightCols(free) * ws.d_.tail(free);
+      if (!dependent) dir.noalias() = J.rightCols(free) * dvec.tail(free);
       // back substitution r = R⁻¹ d₁
       for (Index i = na - 1; i >= 0; --i) {
-        double acc = ws.d_[i];
-        for (Index j = i + 1; j < na; ++j) acc -= ws.R_(i, j) * ws.r_[j];
-        ws.r_[i] = acc / ws.R_(i, i);
+        double acc = dvec[i];
+        for (Index j = i + 1; j < na; ++j) acc -= R(i, j) * rvec[j];
+        rvec[i] = acc / R(i, i);
       }
       // partial (dual) step length: first active multiplier to reach 0
       double t1 = inf;
       Index k = -1;
       for (Index j = 0; j < na; ++j) {
-        if (ws.r_[j] > 0.0 && ws.u_[j] / ws.r_[j] < t1) {
-          t1 = ws.u_[j] / ws.r_[j];
+        if (rvec[j] > 0.0 && uvec[j] / rvec[j] < t1) {
+          t1 = uvec[j] / rvec[j];
           k = j;
         }
       }
       // full step length: row p becomes tight
-      const double t2 = dependent ? inf : -ws.s_[p] / (d2 * d2);
+      const double t2 = dependent ? inf : -s[p] / (d2 * d2);
       if (t1 == inf && t2 == inf) {
         res.status = LcpStatus::NoSolution;
         res.message = "constraints A x + q >= 0 are infeasible: no solution";
@@ -185,30 +208,30 @@ LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace&
       }
       const double t = std::min(t1, t2);
       // update the multipliers (and the primal point when the row is independent)
-      for (Index j = 0; j < na; ++j) ws.u_[j] -= t * ws.r_[j];
+      for (Index j = 0; j < na; ++j) uvec[j] -= t * rvec[j];
       u_new += t;
       if (!dependent) {
-        ws.x_.noalias() += t * ws.dir_;
-        ws.as_.noalias() = problem.A * ws.dir_;
-        ws.s_.noalias() += t * ws.as_;
+        x.noalias() += t * dir;
+        as.noalias() = A * dir;
+        s.noalias() += t * as;
       }
       if (t2 <= t1) {
         // add row p: rotate d so only its first na+1 entries are non-zero
         for (Index j = m - 1; j > na; --j) {
-          double c, s;
-          givens(ws.d_[j - 1], ws.d_[j], c, s);
-          ws.d_[j - 1] = c * ws.d_[j - 1] + s * ws.d_[j];
-          ws.d_[j] = 0.0;
-          rotateColumns(ws.J_, j - 1, j, c, s);
+          double c, sn;
+          givens(dvec[j - 1], dvec[j], c, sn);
+          dvec[j - 1] = c * dvec[j - 1] + sn * dvec[j];
+          dvec[j] = 0.0;
+          rotateColumns(J, j - 1, j, c, sn);
         }
-        ws.R_.col(na).head(na + 1) = ws.d_.head(na + 1);
-        ws.u_[na] = u_new;
+        R.col(na).head(na + 1) = dvec.head(na + 1);
+        uvec[na] = u_new;
         ws.active_.push_back(static_cast<int>(p));
         ws.is_active_[u(p)] = 1;
         ++na;
         break;
       }
-      ws.u_[k] = 0.0;
+      uvec[k] = 0.0;
       drop(k);
     }
   }
@@ -216,22 +239,48 @@ LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace&
   ws.previous_.assign(ws.active_.begin(), ws.active_.end());
 
   // z from the multipliers; x and w recomputed from the data
-  res.z.setZero(n);
-  for (Index j = 0; j < na; ++j) res.z[ws.active_[u(j)]] = std::max(0.0, ws.u_[j]);
-  if (!res.z.allFinite()) {
-    res.z.setZero();
+  auto z = res.z.head(n);
+  auto w = res.w.head(n);
+  z.setZero();
+  for (Index j = 0; j < na; ++j) z[ws.active_[u(j)]] = std::max(0.0, uvec[j]);
+  if (!z.allFinite()) {
+    z.setZero();
     res.status = LcpStatus::NumericalFailure;
     res.message = "non-finite multipliers";
   }
-  ws.x_.noalias() = problem.A.transpose() * res.z;
-  res.w.noalias() = problem.A * ws.x_;
-  res.w += problem.q;
-  res.residuals = computeResiduals(problem.q, res.z, res.w);
+  x.noalias() = A.transpose() * z;
+  w.noalias() = A * x;
+  w += q;
+  res.residuals = computeResiduals(q, z, w);
   if (res.status == LcpStatus::Solved && !isComplementary(res.residuals, options.check_tolerance)) {
     res.status = LcpStatus::NumericalFailure;
     res.message = "active set fails the residual check";
   }
+  return res.status;
+}
+
+}  // namespace
+
+LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace& ws,
+                          const StructuredOptions& options) {
+  LcpResult res;
+  if (const char* err = check(problem.A, problem.q, options)) {
+    fail(res, err);
+    return res;
+  }
+  res.z.resize(problem.q.size());
+  res.w.resize(problem.q.size());
+  solveViews(problem.A, problem.q, ws, options, res);
   return res;
+}
+
+LcpStatus solveStructured(const MatrixView& A, const VectorView& q, StructuredWorkspace& workspace,
+                          const StructuredOptions& options, LcpResult& result) {
+  if (const char* err = check(A, q, options)) return fail(result, err);
+  if (result.z.size() < q.size() || result.w.size() < q.size()) {
+    return fail(result, "result.z and result.w need at least n entries (LcpResult::reserve)");
+  }
+  return solveViews(A, q, workspace, options, result);
 }
 
 const char* factorPsd(const Eigen::MatrixXd& M, Eigen::MatrixXd& A, double rank_tol) {

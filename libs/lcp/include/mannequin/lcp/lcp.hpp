@@ -48,15 +48,28 @@ struct LcpResult {
   int pivots = 0;          ///< pivots (Lemke), sweeps (PGS) or active-set steps (structured)
   LcpResiduals residuals;  ///< of (z, w) against the original data
   const char* message = "";  ///< static string explaining the status
+  /// Capacity path: sizes z and w to `capacity` entries once, so that the solvers' view overloads
+  /// (M, q given as blocks of capacity-sized buffers) write the first n ≤ capacity entries without
+  /// allocating; entries past n are left untouched.
+  void reserve(Index capacity) {
+    if (z.size() < capacity) z.setZero(capacity);
+    if (w.size() < capacity) w.setZero(capacity);
+  }
 };
+
+/// Read-only views of M (n×n) and q (n): a whole matrix or a block of a larger, capacity-sized one
+/// (no copy either way).
+using MatrixView = Eigen::Ref<const Eigen::MatrixXd>;
+using VectorView = Eigen::Ref<const Eigen::VectorXd>;
 
 /// Checks M square, q of matching size, all entries finite. Returns nullptr when valid,
 /// otherwise a static message.
 const char* validate(const LcpProblem& problem);
+/// Same checks on views.
+const char* validate(const MatrixView& M, const VectorView& q);
 
 /// Residuals of z (n) against q (n); w (n) must already equal M z + q.
-LcpResiduals computeResiduals(const Eigen::VectorXd& q, const Eigen::VectorXd& z,
-                              const Eigen::VectorXd& w);
+LcpResiduals computeResiduals(const VectorView& q, const VectorView& z, const VectorView& w);
 
 /// True when both relative residuals are at most tol.
 inline bool isComplementary(const LcpResiduals& r, double tol) {

@@ -39,17 +39,23 @@ struct LemkeOptions {
   double check_tolerance = 1e-9;
 };
 
-/// Pre-sized storage for solveLemke. Resized (and allocated) only when n changes.
+/// Pre-sized storage for solveLemke. Its buffers only grow: reserve(capacity) once and every later
+/// problem of size n ≤ capacity uses their leading blocks without allocating.
 class LemkeWorkspace {
  public:
   LemkeWorkspace() = default;
   explicit LemkeWorkspace(Index n) { resize(n); }
-  /// Allocates for problems of size n.
+  /// Allocates for problems of any size ≤ capacity (nothing when already that large).
+  void reserve(Index capacity);
+  /// Prepares for a problem of size n (allocates only when n exceeds the capacity).
   void resize(Index n);
   Index size() const { return n_; }
+  Index capacity() const { return capacity_; }
 
   // internal state, public so the solver is a free function (do not modify)
   Index n_ = -1;
+  Index capacity_ = -1;
+  // buffers are capacity-sized; the solver uses their leading n (n+1) rows/columns
   Eigen::MatrixXd tableau_;  // n×(n+1), B⁻¹ times the non-basic columns of [I, −M, −d]
   Eigen::VectorXd rhs_;      // n, B⁻¹ q: values of the basic variables
   Eigen::VectorXd col_;      // n, pivot column copy
@@ -76,5 +82,12 @@ LcpResult solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace,
 /// real-time loop.
 LcpStatus solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace, const LemkeOptions& options,
                      LcpResult& result);
+
+/// The capacity path: M (n×n) and q (n) are views (typically leading blocks of capacity-sized
+/// buffers); the answer goes to the first n entries of result.z and result.w, which must hold at
+/// least n entries (result.reserve(capacity); otherwise Invalid). No heap allocation once
+/// workspace.reserve(capacity) and result.reserve(capacity) have run, for every n ≤ capacity.
+LcpStatus solveLemke(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+                     const LemkeOptions& options, LcpResult& result);
 
 }  // namespace mannequin::lcp

@@ -21,15 +21,20 @@ struct PgsOptions {
   double check_tolerance = 1e-9;
 };
 
-/// Pre-sized storage for solvePgs (the transposed matrix for row access, the iterate).
+/// Pre-sized storage for solvePgs (the transposed matrix for row access, the iterate). Its buffers
+/// only grow (capacity-sized; the solver uses their leading n entries).
 struct PgsWorkspace {
   PgsWorkspace() = default;
   explicit PgsWorkspace(Index n) { resize(n); }
-  /// Allocates for size n; keeps the iterate when n is unchanged.
+  /// Allocates for every size ≤ capacity (nothing when already that large).
+  void reserve(Index capacity);
+  /// Prepares for size n: keeps the iterate when n is unchanged, else zeroes it; allocates only when
+  /// n exceeds the capacity.
   void resize(Index n);
-  Eigen::MatrixXd mt_;  ///< n×n, Mᵀ so that row i of M is a contiguous column
-  Eigen::VectorXd z_;   ///< n, current iterate (warm start)
-  Eigen::VectorXd inv_diag_;  ///< n, 1 / M_ii
+  Eigen::MatrixXd mt_;  ///< capacity², Mᵀ (leading n×n) so that row i of M is a contiguous column
+  Eigen::VectorXd z_;   ///< capacity, current iterate (leading n; warm start)
+  Eigen::VectorXd inv_diag_;  ///< capacity, 1 / M_ii (leading n)
+  Index n_ = -1;        ///< size of the last problem
 };
 
 /// Solves the LCP (M n×n, q n) by projected Gauss–Seidel. Needs M_ii > 0 for every i
@@ -37,5 +42,11 @@ struct PgsWorkspace {
 /// (not converged within max_iterations; z is the last, finite iterate) or Invalid.
 LcpResult solvePgs(const LcpProblem& problem, PgsWorkspace& workspace,
                    const PgsOptions& options = {});
+
+/// The capacity path (as solveLemke's view overload): M, q views, answer in the first n entries of
+/// result.z / result.w (at least n entries, else Invalid). No heap allocation once the workspace
+/// and the result are reserved for n.
+LcpStatus solvePgs(const MatrixView& M, const VectorView& q, PgsWorkspace& workspace,
+                   const PgsOptions& options, LcpResult& result);
 
 }  // namespace mannequin::lcp

@@ -35,11 +35,15 @@ struct StructuredOptions {
   double check_tolerance = 1e-9;
 };
 
-/// Pre-sized storage for solveStructured; also keeps the last active set for warm starts.
+/// Pre-sized storage for solveStructured; also keeps the last active set for warm starts. Its
+/// buffers only grow (capacity-sized; the solver uses their leading blocks).
 struct StructuredWorkspace {
   StructuredWorkspace() = default;
   StructuredWorkspace(Index n, Index m) { resize(n, m); }
-  /// Allocates for n rows and m columns; keeps the active set when sizes are unchanged.
+  /// Allocates for every problem of at most n_capacity rows and m_capacity columns.
+  void reserve(Index n_capacity, Index m_capacity);
+  /// Prepares for n rows and m columns; keeps the active set when sizes are unchanged; allocates
+  /// only beyond the capacity.
   void resize(Index n, Index m);
   Eigen::MatrixXd J_;   ///< m×m orthogonal factor
   Eigen::MatrixXd R_;   ///< m×m, upper-triangular in its leading active block
@@ -55,6 +59,7 @@ struct StructuredWorkspace {
   std::vector<int> previous_; ///< active rows of the last solve (warm start)
   std::vector<char> is_active_, hinted_;  ///< n flags
   Index n_ = -1, m_ = -1;
+  Index n_cap_ = 0, m_cap_ = 0;
 };
 
 /// Solves 0 ≤ A Aᵀ z + q ⊥ z ≥ 0 (A n×m, q n). On return workspace.x_ holds x = Aᵀz.
@@ -62,6 +67,12 @@ struct StructuredWorkspace {
 /// Invalid or NumericalFailure.
 LcpResult solveStructured(const StructuredProblem& problem, StructuredWorkspace& workspace,
                           const StructuredOptions& options = {});
+
+/// The capacity path: A (n×m) and q (n) are views (blocks of capacity-sized buffers), the answer
+/// goes to the first n entries of result.z / result.w (at least n entries, else Invalid). No heap
+/// allocation once workspace.reserve(n_cap, m_cap) and result.reserve(n_cap) have run.
+LcpStatus solveStructured(const MatrixView& A, const VectorView& q, StructuredWorkspace& workspace,
+                          const StructuredOptions& options, LcpResult& result);
 
 /// Factors a symmetric positive semidefinite M (n×n) as M ≈ A Aᵀ with A n×r (r = numerical
 /// rank) by a symmetric eigendecomposition, dropping eigenvalues ≤ rank_tol · λ_max.
