@@ -169,3 +169,52 @@ TEST(Anthropometry, BadConfigsNameFileLineAndKey) {
   bad.mass = std::nan("");
   EXPECT_THROW(buildMannequin(bad), std::invalid_argument);
 }
+
+TEST(Anthropometry, BallJointsGetSwingTwistLimitsFromTheBoxesOrTheConfig) {
+  const double kD = 3.14159265358979323846 / 180.0;
+  const Model m = buildMannequin(parseMannequinSpec("sex: male\nstature_m: 1.75\nmass_kg: 75\n", "t.yaml"));
+  // hip_l: box x [-30, 45], y [-120, 30], z [-45, 45]; twist axis −z (thigh hangs down)
+  const BallLimit& hip = m.joints[m.jointIndex("hip_l")].ball_limit;
+  ASSERT_TRUE(hip.enabled);
+  EXPECT_LT((hip.twist_axis + Vector3::UnitZ()).norm(), 1e-12);
+  EXPECT_NEAR(hip.swing_cx, 7.5 * kD, 1e-12);
+  EXPECT_NEAR(hip.swing_a, 37.5 * kD, 1e-12);
+  EXPECT_NEAR(hip.swing_cy, -45 * kD, 1e-12);
+  EXPECT_NEAR(hip.swing_b, 75 * kD, 1e-12);
+  EXPECT_NEAR(hip.twist_lower, -45 * kD, 1e-12);  // [−hi_z, −lo_z] about −z
+  EXPECT_NEAR(hip.twist_upper, 45 * kD, 1e-12);
+  // the neck's axis is +z (head above): twist = the z box
+  EXPECT_LT((m.joints[m.jointIndex("neck")].ball_limit.twist_axis - Vector3::UnitZ()).norm(), 1e-12);
+  // shoulder_l: the box's inscribed ellipse reaches past 170°: scaled about 0 to reach 170° exactly
+  const BallLimit& sh = m.joints[m.jointIndex("shoulder_l")].ball_limit;
+  EXPECT_NEAR(sh.maxSwing(), BallLimit::kMaxSwing, 1e-6);
+  EXPECT_NEAR(sh.swing_cx / sh.swing_a, 70.0 / 100.0, 1e-12);
+  // explicit values in degrees
+  const MannequinSpec spec = parseMannequinSpec(
+      "sex: male\nstature_m: 1.75\nmass_kg: 75\nball_limits_deg:\n  shoulder_l: {swing_axes: [80, 90], swing_center: [50, "
+      "-40], twist: [-80, 60]}\n",
+      "t.yaml");
+  const Model m2 = buildMannequin(spec);
+  const BallLimit& s2 = m2.joints[m2.jointIndex("shoulder_l")].ball_limit;
+  EXPECT_NEAR(s2.swing_a, 80 * kD, 1e-12);
+  EXPECT_NEAR(s2.swing_cy, -40 * kD, 1e-12);
+  EXPECT_NEAR(s2.twist_lower, -80 * kD, 1e-12);
+  // errors name FILE:LINE and the key
+  const auto err = [](const std::string& yaml) {
+    try {
+      parseMannequinSpec("sex: male\nstature_m: 1.75\nmass_kg: 75\nball_limits_deg:\n" + yaml, "t.yaml");
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(err("  knee_l: {twist: [-10, 10]}\n").find("t.yaml:5: field 'ball_limits_deg.knee_l': 'knee_l' is not a ball"),
+            std::string::npos);
+  EXPECT_NE(err("  hip_l: {swing_axes: [170, 170]}\n").find("t.yaml:5: field 'ball_limits_deg.hip_l': the swing ellipse reaches"),
+            std::string::npos);
+  EXPECT_NE(err("  hip_l: {swing_center: [50, 0]}\n").find("must contain the rest direction"), std::string::npos);
+  EXPECT_NE(err("  hip_l: {twist: [10, 20]}\n").find("twist range [lower, upper] must contain 0"), std::string::npos);
+  EXPECT_NE(err("  hip_l: {swing_axes: [-1, 20]}\n").find("semi-axes must be > 0"), std::string::npos);
+  EXPECT_NE(err("  hip_l: {twist_axis: [0, 0, 0]}\n").find("twist_axis"), std::string::npos);
+  EXPECT_NE(err("  hip_l: {swing: [1, 2]}\n").find("t.yaml:5"), std::string::npos);
+}

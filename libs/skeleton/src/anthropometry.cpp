@@ -248,7 +248,92 @@ Model buildMannequin(const MannequinSpec& spec) {
                                   coord + "'");
     model.setLimits(static_cast<int>(it - names.begin()), lim.first * kDeg, lim.second * kDeg);
   }
+  // swing/twist limits of every ball joint: from the boxes above, overridden by the spec
+  for (const auto& [jname, deg] : spec.ball_limits_deg) {
+    const int j = model.findJoint(jname);
+    if (j < 0 || model.joints[j].type != JointType::kBall)
+      throw std::invalid_argument("mannequin '" + spec.name + "': swing/twist limits for '" + jname +
+                                  "', which is not a ball joint");
+  }
+  for (int j = 0; j < static_cast<int>(model.joints.size()); ++j) {
+    if (model.joints[j].type != JointType::kBall) continue;
+    const auto it = spec.ball_limits_deg.find(model.joints[j].name);
+    model.setBallLimit(j, it == spec.ball_limits_deg.end() ? defaultBallLimit(model, j)
+                                                           : ballLimitFromSpec(model, j, it->second));
+  }
   return model;
+}
+
+BallLimit defaultBallLimit(const Model& model, int joint) {
+  const Joint& jt = model.joints.at(joint);
+  BallLimit l;
+  l.twist_axis = -Vector3::UnitZ();
+  for (const Segment& seg : model.segments)
+    if (seg.joint == joint && seg.com.norm() > 1e-9) {
+      l.twist_axis = seg.com.normalized();
+      break;
+    }
+  swingBasis(l.twist_axis, l.swing_x, l.swing_y);
+  // range of the box along a unit axis e: the component k with the largest |e_k|, signed
+  const auto range = [&](const Vector3& e, double& lo, double& hi) {
+    int k = 0;
+    e.cwiseAbs().maxCoeff(&k);
+    const double a = model.lower_limit(jt.idx_q + k), b = model.upper_limit(jt.idx_q + k);
+    if (e(k) >= 0) {
+      lo = a;
+      hi = b;
+    } else {
+      lo = -b;
+      hi = -a;
+    }
+    // an unlimited component: the largest range allowed
+    lo = std::isfinite(lo) ? lo : -BallLimit::kMaxSwing;
+    hi = std::isfinite(hi) ? hi : BallLimit::kMaxSwing;
+  };
+  double lx, hx, ly, hy;
+  range(l.swing_x, lx, hx);
+  range(l.swing_y, ly, hy);
+  range(l.twist_axis, l.twist_lower, l.twist_upper);
+  l.twist_lower = std::max(l.twist_lower, -BallLimit::kMaxTwist);
+  l.twist_upper = std::min(l.twist_upper, BallLimit::kMaxTwist);
+  l.swing_cx = 0.5 * (lx + hx);
+  l.swing_cy = 0.5 * (ly + hy);
+  const double a = 0.5 * (hx - lx), b = 0.5 * (hy - ly);
+  l.swing_a = a;
+  l.swing_b = b;
+  const double m = l.maxSwing();
+  if (m > BallLimit::kMaxSwing) {
+    // shrink the ellipse about s = 0 (centre and semi-axes by the same factor): it keeps containing 0
+    // and its farthest point comes to kMaxSwing
+    const double k = (BallLimit::kMaxSwing - 1e-9) / m;
+    l.swing_cx *= k;
+    l.swing_cy *= k;
+    l.swing_a *= k;
+    l.swing_b *= k;
+  }
+  l.enabled = true;
+  return l;
+}
+
+BallLimit ballLimitFromSpec(const Model& model, int joint, const MannequinSpec::BallLimitDeg& deg) {
+  BallLimit l = defaultBallLimit(model, joint);
+  if (deg.twist_axis) {
+    l.twist_axis = deg.twist_axis->normalized();
+    swingBasis(l.twist_axis, l.swing_x, l.swing_y);
+  }
+  if (deg.swing_axes) {
+    l.swing_a = deg.swing_axes->first * kDeg;
+    l.swing_b = deg.swing_axes->second * kDeg;
+  }
+  if (deg.swing_center) {
+    l.swing_cx = deg.swing_center->first * kDeg;
+    l.swing_cy = deg.swing_center->second * kDeg;
+  }
+  if (deg.twist) {
+    l.twist_lower = deg.twist->first * kDeg;
+    l.twist_upper = deg.twist->second * kDeg;
+  }
+  return l;
 }
 
 VectorX standingConfiguration(const Model& model) {
@@ -265,8 +350,8 @@ VectorX standingConfiguration(const Model& model) {
 // ---- YAML config ------------------------------------------------------------------------
 namespace {
 MannequinSpec readMannequinSpec(const core::ConfigNode& root) {
-  root.allowOnly({"name", "sex", "stature_m", "mass_kg", "toes", "density_kg_m3", "joint_limits_deg", "description",
-                  "source"});
+  root.allowOnly({"name", "sex", "stature_m", "mass_kg", "toes", "density_kg_m3", "joint_limits_deg",
+                  "ball_limits_deg", "description", "source"});
   MannequinSpec spec;
   spec.name = root.get("name", spec.name);
   spec.sex = root["sex"].choice({"male", "female"}) == 0 ? Sex::kMale : Sex::kFemale;
@@ -284,6 +369,35 @@ MannequinSpec readMannequinSpec(const core::ConfigNode& root) {
       const Eigen::VectorXd lim = r.vector(2);
       if (lim(0) > lim(1)) r.fail("[min, max] in degrees with min > max");
       spec.limits_deg[coord] = {lim(0), lim(1)};
+    }
+  }
+  if (const auto balls = root.find("ball_limits_deg")) {
+    // joints are checked against the model with the box overrides (the defaults derive from them)
+    const Model model = buildMannequin(spec);
+    for (const std::string& jname : balls->keys()) {
+      const core::ConfigNode e = (*balls)[jname];
+      const int j = model.findJoint(jname);
+      if (j < 0 || model.joints[j].type != JointType::kBall)
+        e.fail("'" + jname + "' is not a ball joint (see docs/mannequin-model.md, \"Joints\")");
+      e.allowOnly({"swing_axes", "swing_center", "twist", "twist_axis"});
+      MannequinSpec::BallLimitDeg deg;
+      const auto pair = [&](const char* key, std::optional<std::pair<double, double>>& out) {
+        if (const auto n = e.find(key)) {
+          const Eigen::VectorXd v = n->vector(2);
+          out = std::pair<double, double>{v(0), v(1)};
+        }
+      };
+      pair("swing_axes", deg.swing_axes);
+      pair("swing_center", deg.swing_center);
+      pair("twist", deg.twist);
+      if (const auto n = e.find("twist_axis")) {
+        const Vector3 t = n->vec3();
+        if (t.norm() < 1e-9) n->fail("the twist axis must not be zero");
+        deg.twist_axis = t.normalized();
+      }
+      const std::string err = checkBallLimit(ballLimitFromSpec(model, j, deg));
+      if (!err.empty()) e.fail(err);
+      spec.ball_limits_deg[jname] = deg;
     }
   }
   return spec;

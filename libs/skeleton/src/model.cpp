@@ -1,5 +1,6 @@
 #include "mannequin/skeleton/model.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -101,6 +102,57 @@ void Model::setLimits(int idx_q, double lower, double upper) {
          std::to_string(upper) + "] are not an interval");
   lower_limit(idx_q) = lower;
   upper_limit(idx_q) = upper;
+}
+
+void Model::setBallLimit(int joint, const BallLimit& limit) {
+  if (joint < 0 || joint >= static_cast<int>(joints.size())) fail("ball limit: joint index " + std::to_string(joint) + " does not exist");
+  if (joints[joint].type != JointType::kBall) fail("joint '" + joints[joint].name + "' is not a ball joint: no swing/twist limits");
+  const std::string err = checkBallLimit(limit);
+  if (!err.empty()) fail("joint '" + joints[joint].name + "': swing/twist limits: " + err);
+  joints[joint].ball_limit = limit;
+  joints[joint].ball_limit.enabled = true;
+}
+
+double BallLimit::maxSwing() const {
+  double m = 0.0;
+  constexpr int kSamples = 720;
+  for (int i = 0; i < kSamples; ++i) {
+    const double phi = 2.0 * 3.14159265358979323846 * i / kSamples;
+    m = std::max(m, std::hypot(swing_cx + swing_a * std::cos(phi), swing_cy + swing_b * std::sin(phi)));
+  }
+  return m;
+}
+
+std::string checkBallLimit(const BallLimit& l) {
+  const double vals[] = {l.swing_a, l.swing_b, l.swing_cx, l.swing_cy, l.twist_lower, l.twist_upper};
+  for (double v : vals)
+    if (!std::isfinite(v)) return "a value is not finite";
+  if (!l.twist_axis.allFinite() || !l.swing_x.allFinite() || !l.swing_y.allFinite()) return "an axis is not finite";
+  constexpr double kTol = 1e-9;
+  if (std::abs(l.twist_axis.norm() - 1) > kTol || std::abs(l.swing_x.norm() - 1) > kTol ||
+      std::abs(l.swing_y.norm() - 1) > kTol)
+    return "the twist axis and the swing axes must be unit vectors";
+  if (std::abs(l.twist_axis.dot(l.swing_x)) > kTol || std::abs(l.twist_axis.dot(l.swing_y)) > kTol ||
+      std::abs(l.swing_x.dot(l.swing_y)) > kTol)
+    return "the twist axis and the swing axes must be orthogonal";
+  if (l.swing_a <= 0 || l.swing_b <= 0) return "the swing ellipse's semi-axes must be > 0";
+  const double cx = l.swing_cx / l.swing_a, cy = l.swing_cy / l.swing_b;
+  if (cx * cx + cy * cy >= 1.0) return "the swing ellipse must contain the rest direction (swing 0)";
+  if (l.maxSwing() > BallLimit::kMaxSwing + 1e-9)
+    return "the swing ellipse reaches " + std::to_string(l.maxSwing() * 180 / 3.14159265358979323846) +
+           " deg, past the 170 deg allowed (the swing/twist decomposition is singular at 180 deg)";
+  if (!(l.twist_lower <= 0 && 0 <= l.twist_upper)) return "the twist range [lower, upper] must contain 0";
+  if (l.twist_lower < -BallLimit::kMaxTwist - 1e-9 || l.twist_upper > BallLimit::kMaxTwist + 1e-9)
+    return "the twist range must stay within [-170, 170] deg (the twist angle wraps at 180 deg)";
+  return {};
+}
+
+void swingBasis(const Vector3& t, Vector3& e1, Vector3& e2) {
+  const bool along_x = std::abs(t.x()) > 0.9;
+  const Vector3 a = along_x ? Vector3::UnitY() : Vector3::UnitX();
+  const Vector3 b = along_x ? Vector3::UnitZ() : Vector3::UnitY();
+  e1 = (a - a.dot(t) * t).normalized();
+  e2 = (b - b.dot(t) * t - b.dot(e1) * e1).normalized();
 }
 
 int Model::findJoint(const std::string& n) const { return findByName(joints, n); }

@@ -35,6 +35,39 @@ enum class JointType { kRevolute, kBall, kFreeFlyer };
 /// Name of a joint type as written in configs ("revolute", "ball", "free_flyer").
 const char* toString(JointType type);
 
+/// Swing/twist limits of a ball joint (thesis Annex D.2, after Baerlocher & Boulic). The ball's
+/// rotation R (child in the joint placement frame, R = exp([q])) is split R = R_s R_t about the
+/// TWIST AXIS t (unit, joint frame; the child segment's long axis, from the joint centre to its CoM):
+/// R_s the geodesic rotation taking t to R t, with rotation vector s = θ_s u ⟂ t (θ_s ∈ [0, π]),
+/// R_t = exp(θ_t [t]) the rest, θ_t ∈ (−π, π] the signed twist angle. Limits:
+/// - swing: the ellipse ((s·e1 − c_x)/a)² + ((s·e2 − c_y)/b)² ≤ 1 on the swing vector (rad), e1, e2
+///   an orthonormal basis of the plane ⟂ t (joint frame);
+/// - twist: θ_t ∈ [twist_lower, twist_upper] (rad).
+/// The ellipse must contain s = 0 and stay inside |s| ≤ kMaxSwing (the decomposition is singular
+/// at θ_s = π); checkBallLimit() says what is wrong.
+struct BallLimit {
+  static constexpr double kMaxSwing = 170.0 * 3.14159265358979323846 / 180.0;  ///< rad
+  static constexpr double kMaxTwist = 170.0 * 3.14159265358979323846 / 180.0;  ///< rad
+  bool enabled = false;
+  Vector3 twist_axis = -Vector3::UnitZ();  ///< t, unit, joint frame
+  Vector3 swing_x = Vector3::UnitX();      ///< e1, unit, ⟂ t
+  Vector3 swing_y = Vector3::UnitY();      ///< e2, unit, ⟂ t and e1
+  double swing_a = 1.0, swing_b = 1.0;     ///< semi-axes along e1, e2 (rad, > 0)
+  double swing_cx = 0.0, swing_cy = 0.0;   ///< centre of the ellipse (rad); the thesis's form is c = 0
+  double twist_lower = -1.0, twist_upper = 1.0;  ///< rad
+  /// Largest |s| on the ellipse (rad), by sampling 720 points.
+  double maxSwing() const;
+};
+
+/// Empty when `limit` is usable, else what is wrong (non-unit or non-orthogonal axes, a ≤ 0,
+/// an ellipse not containing 0 or reaching past kMaxSwing, a twist range not containing 0 or
+/// outside ±kMaxTwist, a non-finite value).
+std::string checkBallLimit(const BallLimit& limit);
+
+/// An orthonormal basis (e1, e2) of the plane ⟂ t: Gram–Schmidt of the joint frame's x then y
+/// axes (y then z when t ∥ x). For t = ±z: e1 = x, e2 = y.
+void swingBasis(const Vector3& t, Vector3& e1, Vector3& e2);
+
 /// One joint of the tree; each joint carries a moving frame ("joint frame").
 struct Joint {
   std::string name;
@@ -46,6 +79,7 @@ struct Joint {
   int idx_v = 0;                    ///< first coordinate in v
   int nq = 0;                       ///< coordinates (1, 3 or 6)
   int nv = 0;                       ///< velocity coordinates (== nq)
+  BallLimit ball_limit;             ///< ball only: swing/twist limits (disabled: none)
 };
 
 /// A capsule for collision: the segment line from `a` to `b` (joint frame) swept by a sphere.
@@ -99,6 +133,10 @@ class Model {
   int addFrame(const std::string& name, int joint, const SE3& placement);
   /// Sets limits of one coordinate (rad). \throws std::invalid_argument if lower > upper or NaN.
   void setLimits(int idx_q, double lower, double upper);
+
+  /// Sets the swing/twist limits of ball joint `joint` (enabled). \throws std::invalid_argument
+  /// naming the joint on a non-ball joint or when checkBallLimit() reports a problem.
+  void setBallLimit(int joint, const BallLimit& limit);
 
   /// Index of a joint/segment/frame by name. \throws std::invalid_argument naming the missing
   /// item and listing what exists.
