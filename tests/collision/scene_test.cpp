@@ -196,3 +196,93 @@ TEST(Scene, ShippedScenesLoadAndCockpitPanelIsDense) {
       if (s.shape.type == ShapeType::kMesh) tris = std::max(tris, s.shape.mesh->triangles.size());
   EXPECT_GE(tris, 10000u);
 }
+
+// Dynamics of movable bodies (sim::RigidObject): mass, inertia (default: solid bounding box), hinge.
+TEST(Scene, MovableBodyDynamics) {
+  const SceneSpec s = parseScene(
+      "bodies:\n"
+      "  - name: tray\n"
+      "    movable: true\n"
+      "    mass: 1.2\n"
+      "    shapes: [{type: box, size: [0.4, 0.3, 0.02]}]\n"
+      "  - name: ball\n"
+      "    movable: true\n"
+      "    mass: 0.45\n"
+      "    inertia: [0.002, 0.002, 0.002]\n"
+      "    time_constant: 0.1\n"
+      "    shape: {type: sphere, radius: 0.11}\n"
+      "  - name: door\n"
+      "    movable: true\n"
+      "    mass: 20\n"
+      "    hinge: {axis: [0, 0, 2], point: [1, 0, 0], limits_deg: [-10, 90]}\n"
+      "    shape: {type: box, size: [0.9, 0.04, 2.0], pose: {position: [0.45, 0, 0]}}\n"
+      "  - name: kinematic\n"
+      "    movable: true\n"
+      "    shape: {type: sphere, radius: 0.1}\n",
+      "test.yaml");
+  ASSERT_EQ(s.bodies.size(), 4u);
+  ASSERT_TRUE(s.bodies[0].dynamics);
+  const BodyDynamics& tray = *s.bodies[0].dynamics;
+  EXPECT_DOUBLE_EQ(tray.mass, 1.2);
+  // solid box 0.4 × 0.3 × 0.02: Ixx = m (0.3² + 0.02²)/12 ...
+  EXPECT_NEAR(tray.inertia.x(), 1.2 * (0.09 + 0.0004) / 12, 1e-12);
+  EXPECT_NEAR(tray.inertia.y(), 1.2 * (0.16 + 0.0004) / 12, 1e-12);
+  EXPECT_NEAR(tray.inertia.z(), 1.2 * (0.16 + 0.09) / 12, 1e-12);
+  EXPECT_LT(tray.time_constant, 0.0);  // the simulation's default
+  EXPECT_FALSE(tray.hinge);
+  const BodyDynamics& ball = *s.bodies[1].dynamics;
+  EXPECT_DOUBLE_EQ(ball.inertia.z(), 0.002);
+  EXPECT_DOUBLE_EQ(ball.time_constant, 0.1);
+  const BodyDynamics& door = *s.bodies[2].dynamics;
+  ASSERT_TRUE(door.hinge);
+  EXPECT_TRUE(door.hinge->axis.isApprox(mannequin::math::Vector3::UnitZ()));
+  EXPECT_TRUE(door.hinge->point.isApprox(mannequin::math::Vector3(1, 0, 0)));
+  EXPECT_NEAR(door.hinge->lower, -10 * M_PI / 180, 1e-15);
+  EXPECT_NEAR(door.hinge->upper, 90 * M_PI / 180, 1e-15);
+  // the bounding box follows the shape's pose in the body frame: x ∈ [0, 0.9]
+  EXPECT_NEAR(door.inertia.z(), 20 * (0.81 + 0.0016) / 12, 1e-12);
+  EXPECT_FALSE(s.bodies[3].dynamics);  // movable without mass: kinematic
+
+  // shipped: the table's ball (Fig. 3.6) and tray, the door and the lever on their hinges
+  const auto body = [](const SceneSpec& sc, const std::string& name) -> const BodySpec& {
+    for (const BodySpec& b : sc.bodies)
+      if (b.name == name) return b;
+    throw std::runtime_error("no body " + name);
+  };
+  const SceneSpec table = loadScene(test::sourcePath("configs/scenes/table.yaml"));
+  ASSERT_TRUE(body(table, "ball").dynamics);
+  EXPECT_DOUBLE_EQ(body(table, "ball").dynamics->mass, 0.45);
+  ASSERT_TRUE(body(table, "tray").dynamics);
+  EXPECT_FALSE(body(table, "tool").dynamics);
+  const SceneSpec dl = loadScene(test::sourcePath("configs/scenes/door_lever.yaml"));
+  ASSERT_TRUE(body(dl, "door").dynamics && body(dl, "door").dynamics->hinge);
+  EXPECT_NEAR(body(dl, "door").dynamics->hinge->upper, 100 * M_PI / 180, 1e-12);
+  ASSERT_TRUE(body(dl, "lever").dynamics && body(dl, "lever").dynamics->hinge);
+  EXPECT_NEAR(body(dl, "lever").dynamics->hinge->lower, -30 * M_PI / 180, 1e-12);
+}
+
+TEST(Scene, MovableBodyDynamicsErrors) {
+  const auto expectError = [](const std::string& yaml, const std::string& what) {
+    const std::string e = sceneError(yaml);
+    EXPECT_NE(e.find(what), std::string::npos) << "yaml:\n" << yaml << "got: " << e;
+  };
+  const std::string head = "bodies:\n  - name: a\n    movable: true\n    shape: {type: sphere, radius: 0.1}\n";
+  expectError(head + "    mass: -1\n", "test.yaml:5: field 'bodies[0].mass': must be > 0, got -1");
+  expectError(head + "    mass: 0\n", "test.yaml:5: field 'bodies[0].mass': must be > 0, got 0");
+  expectError("bodies:\n  - name: a\n    shape: {type: sphere, radius: 0.1}\n    mass: 1\n",
+              "test.yaml:4: field 'bodies[0].mass': only a movable body has dynamics");
+  expectError(head + "    inertia: [1, 1, 1]\n", "test.yaml:5: field 'bodies[0].inertia': needs the body's 'mass'");
+  expectError(head + "    mass: 1\n    inertia: [1, 1]\n", "test.yaml:6: field 'bodies[0].inertia': expected [Ixx, Iyy, Izz]");
+  expectError(head + "    mass: 1\n    inertia: [1, -1, 1]\n", "field 'bodies[0].inertia[1]': must be > 0, got -1");
+  expectError(head + "    mass: 1\n    inertia: [1, 1, 3]\n", "test.yaml:6: field 'bodies[0].inertia': not the principal moments");
+  expectError(head + "    mass: 1\n    time_constant: 0\n", "test.yaml:6: field 'bodies[0].time_constant': must be > 0");
+  expectError(head + "    mass: 1\n    hinge: {point: [0, 0, 0]}\n", "test.yaml:6: field 'bodies[0].hinge': missing key 'axis'");
+  expectError(head + "    mass: 1\n    hinge: {axis: [0, 0, 0]}\n", "test.yaml:6: field 'bodies[0].hinge.axis': must be non-zero");
+  expectError(head + "    mass: 1\n    hinge: {axis: [0, 0, 1], limits_deg: [10, 20]}\n",
+              "test.yaml:6: field 'bodies[0].hinge.limits_deg': the initial pose (angle 0) must lie within [lower, upper]");
+  expectError(head + "    mass: 1\n    hinge: {axis: [0, 0, 1], limits_deg: [0, 0]}\n",
+              "field 'bodies[0].hinge.limits_deg': expected lower < upper");
+  expectError(head + "    mass: 1\n    hinge: {axis: [0, 0, 1], spring: 3}\n", "field 'bodies[0].hinge.spring': unknown key");
+  expectError("bodies:\n  - name: a\n    movable: true\n    shape: {type: plane}\n    mass: 1\n",
+              "test.yaml:5: field 'bodies[0].mass': cannot default 'inertia' from the shapes");
+}

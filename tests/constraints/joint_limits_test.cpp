@@ -7,32 +7,15 @@
 #include "mannequin/math/so3.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
+#include "male50_fixture.hpp"
+
 using namespace mannequin;
 using namespace mannequin::constraints;
 
 namespace {
-const skeleton::Model& male50() {
-  static const skeleton::Model m = skeleton::buildMannequin(skeleton::loadMannequinSpec("configs/mannequins/male_50th.yaml"));
-  return m;
-}
-
-int coordinate(const std::string& name) {
-  const auto names = male50().coordinateNames();
-  for (std::size_t k = 0; k < names.size(); ++k)
-    if (names[k] == name) return static_cast<int>(k);
-  ADD_FAILURE() << "no coordinate " << name;
-  return -1;
-}
-
-/// No gravity, no control frame: only the posture control (k_int 150 N·m/rad) moves the joints.
-control::ControllerConfig postureOnly() {
-  control::ControllerConfig c;
-  c.gravity.setZero();
-  c.internal.stiffness = 150;
-  c.internal.projection = control::InternalProjection::kNone;
-  c.internal.observer.enabled = false;
-  return c;
-}
+using testing_fixture::coordinate;
+using testing_fixture::male50;
+using testing_fixture::postureOnly;
 
 /// Steps with the limits as stage 2 (or without), returns the trajectory of coordinate k.
 std::vector<double> run(control::Controller& ctl, JointLimits* limits, int k, int steps) {

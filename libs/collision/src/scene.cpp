@@ -1,6 +1,9 @@
 #include "mannequin/collision/scene.hpp"
 
+#include <cmath>
 #include <filesystem>
+#include <limits>
+#include <stdexcept>
 #include <map>
 #include <memory>
 #include <set>
@@ -84,17 +87,88 @@ struct Reader {
   }
 };
 
+// `mass`, `inertia`, `hinge`, `time_constant` of a movable body (after its shapes).
+void readDynamics(const ConfigNode& b, BodySpec& body) {
+  const auto mass = b.find("mass");
+  for (const char* key : {"inertia", "hinge", "time_constant"})
+    if (!mass && b.has(key)) b[key].fail("needs the body's 'mass' (kg)");
+  if (!mass) return;
+  if (!body.movable) mass->fail("only a movable body has dynamics (add 'movable: true')");
+  BodyDynamics d;
+  d.mass = mass->positive();
+  if (const auto in = b.find("inertia")) {
+    const auto v = in->items();
+    if (v.size() != 3) in->fail("expected [Ixx, Iyy, Izz] (kg·m², body frame), got " + std::to_string(v.size()) + " values");
+    d.inertia = Vector3(v[0].positive(), v[1].positive(), v[2].positive());
+    // principal moments of a real body: each at most the sum of the other two
+    for (int i = 0; i < 3; ++i)
+      if (d.inertia[i] > d.inertia[(i + 1) % 3] + d.inertia[(i + 2) % 3] + 1e-12)
+        in->fail("not the principal moments of a body: I" + std::string(1, "xyz"[i]) + std::string(1, "xyz"[i]) +
+                 " exceeds the sum of the other two");
+  } else {
+    Vector3 lo, hi;
+    try {
+      bodyBounds(body, lo, hi);
+    } catch (const std::invalid_argument& e) {
+      mass->fail(std::string("cannot default 'inertia' from the shapes: ") + e.what() + "; give 'inertia'");
+    }
+    const Vector3 s = (hi - lo).cwiseMax(1e-6);  // a flat shape still gets a tiny thickness
+    d.inertia = d.mass / 12.0 *
+                Vector3(s.y() * s.y() + s.z() * s.z(), s.x() * s.x() + s.z() * s.z(), s.x() * s.x() + s.y() * s.y());
+  }
+  if (const auto t = b.find("time_constant")) d.time_constant = t->positive();
+  if (const auto h = b.find("hinge")) {
+    h->allowOnly({"axis", "point", "limits_deg"});
+    HingeSpec hinge;
+    if (!h->has("axis")) h->fail("missing key 'axis' ([x, y, z], world frame)");
+    const ConfigNode axis = (*h)["axis"];
+    const Vector3 a = axis.vec3();
+    if (a.norm() < 1e-9) axis.fail("must be non-zero");
+    hinge.axis = a.normalized();
+    if (const auto p = h->find("point")) hinge.point = p->vec3();
+    if (const auto l = h->find("limits_deg")) {
+      const auto v = l->items();
+      if (v.size() != 2) l->fail("expected [lower, upper] (degrees), got " + std::to_string(v.size()) + " values");
+      const double deg = M_PI / 180.0;
+      hinge.lower = v[0].numOrInfinity() * deg;
+      hinge.upper = v[1].numOrInfinity() * deg;
+      if (!(hinge.lower <= 0.0 && 0.0 <= hinge.upper))
+        l->fail("the initial pose (angle 0) must lie within [lower, upper]");
+      if (!(hinge.lower < hinge.upper)) l->fail("expected lower < upper");
+    }
+    d.hinge = hinge;
+  }
+  body.dynamics = d;
+}
+
 SceneSpec readScene(const ConfigNode& root, const std::string& base_dir) {
-  root.allowOnly({"name", "activation_distance", "margin", "bodies"});
+  root.allowOnly({"name", "activation_distance", "margin", "bodies", "default_material", "friction"});
   Reader reader{base_dir, {}};
   SceneSpec scene;
   scene.source = root.file();
   scene.name = root.get("name", scene.name);
   if (const auto a = root.find("activation_distance")) scene.activation_distance = a->nonNegative();
   if (const auto m = root.find("margin")) scene.margin = m->nonNegative();
+  scene.default_material = root.get("default_material", scene.default_material);
+  if (scene.default_material.empty()) root["default_material"].fail("must be non-empty");
+  if (const auto f = root.find("friction")) {
+    f->allowOnly({"default", "pairs"});
+    if (const auto d = f->find("default")) scene.default_mu = d->nonNegative();
+    if (const auto pairs = f->find("pairs"))
+      for (const ConfigNode& p : pairs->items()) {
+        p.allowOnly({"a", "b", "mu"});
+        FrictionPair fp{p["a"].str(), p["b"].str(), p["mu"].nonNegative()};
+        if (fp.a.empty() || fp.b.empty()) p.fail("materials 'a' and 'b' must be non-empty");
+        for (const FrictionPair& q : scene.friction)
+          if ((q.a == fp.a && q.b == fp.b) || (q.a == fp.b && q.b == fp.a))
+            p.fail("pair (" + fp.a + ", " + fp.b + ") given twice");
+        scene.friction.push_back(fp);
+      }
+  }
   std::set<std::string> names;
   for (const ConfigNode& b : root["bodies"].items()) {
-    b.allowOnly({"name", "pose", "movable", "margin", "shapes", "shape"});
+    b.allowOnly({"name", "pose", "movable", "margin", "material", "shapes", "shape", "mass", "inertia", "hinge",
+                 "time_constant"});
     BodySpec body;
     const ConfigNode name = b["name"];
     body.name = name.str();
@@ -103,6 +177,8 @@ SceneSpec readScene(const ConfigNode& root, const std::string& base_dir) {
     if (const auto p = b.find("pose")) body.pose = pose(*p);
     body.movable = b.get("movable", body.movable);
     if (const auto m = b.find("margin")) body.margin = m->nonNegative();
+    body.material = b.get("material", scene.default_material);
+    if (body.material.empty()) b["material"].fail("must be non-empty");
     const auto one = b.find("shape"), list = b.find("shapes");
     if (one && list) b.fail("give either 'shape' or 'shapes', not both");
     if (one) {
@@ -113,12 +189,50 @@ SceneSpec readScene(const ConfigNode& root, const std::string& base_dir) {
     } else {
       b.fail("missing key 'shapes' (a non-empty list of shapes) or 'shape'");
     }
+    readDynamics(b, body);
     scene.bodies.push_back(std::move(body));
   }
   return scene;
 }
 
 }  // namespace
+
+void bodyBounds(const BodySpec& body, Vector3& lo, Vector3& hi) {
+  lo = Vector3::Constant(std::numeric_limits<double>::infinity());
+  hi = -lo;
+  for (const PlacedShape& ps : body.shapes) {
+    const Shape& s = ps.shape;
+    Vector3 slo, shi;  // bounds in the shape frame
+    switch (s.type) {
+      case ShapeType::kPlane:
+        throw std::invalid_argument("body '" + body.name + "' has a plane (unbounded)");
+      case ShapeType::kSphere:
+        shi = Vector3::Constant(s.radius);
+        break;
+      case ShapeType::kBox:
+        shi = s.size / 2;
+        break;
+      case ShapeType::kCapsule:
+        shi = Vector3(s.radius, s.radius, s.radius + s.length / 2);
+        break;
+      case ShapeType::kCylinder:
+        shi = Vector3(s.radius, s.radius, s.length / 2);
+        break;
+      case ShapeType::kMesh:
+        s.mesh->bounds(slo, shi);
+        break;
+    }
+    if (s.type != ShapeType::kMesh) slo = -shi;
+    // the eight corners in the body frame
+    for (int c = 0; c < 8; ++c) {
+      const Vector3 corner((c & 1) ? shi.x() : slo.x(), (c & 2) ? shi.y() : slo.y(), (c & 4) ? shi.z() : slo.z());
+      const Vector3 x = ps.pose.act(corner);
+      lo = lo.cwiseMin(x);
+      hi = hi.cwiseMax(x);
+    }
+  }
+  if (body.shapes.empty()) lo = hi = Vector3::Zero();
+}
 
 SceneSpec parseScene(const std::string& yaml_text, const std::string& source, const std::string& base_dir) {
   return readScene(ConfigNode::parse(yaml_text, source), base_dir);

@@ -24,6 +24,9 @@
 #include <utility>
 #include <vector>
 
+#include "mannequin/constraints/rows.hpp"
+#include "mannequin/constraints/solver.hpp"
+#include "mannequin/constraints/swing_twist.hpp"
 #include "mannequin/control/controller.hpp"
 #include "mannequin/lcp/lemke.hpp"
 
@@ -35,14 +38,64 @@ struct JointLimitOptions {
   int max_rounds = 4;           ///< extra LCP solves when the forces push another coordinate past its limit
 };
 
-/// A limit in the LCP at the last apply().
+/// A limit in the LCP at the last step.
 struct LimitRow {
-  int coordinate = -1;    ///< index in q
-  bool upper = false;
+  int coordinate = -1;    ///< index in q (swing/twist: the ball's first coordinate)
+  bool upper = false;     ///< upper limit (twist: upper bound; swing: false)
   double distance = 0.0;  ///< d_j at q_k (rad; < 0 past the limit)
   double lambda = 0.0;    ///< generalised force along the row (N·m, ≥ 0)
+  RowSource source = RowSource::kJointLimit;  ///< kJointLimit, kSwing or kTwist
+  int row = -1;           ///< index in the RowSet of the step (−1: dropped for capacity)
 };
 
+/// Joint limits as rows of the shared constraint solver (solver.hpp), for one mannequin (system
+/// `system` of the ConstraintSolver, a MannequinSystem on `controller`). At q_k, for every limit:
+/// - revolute coordinate k (thesis 3.16–3.17): d = q_k − lower (J = e_kᵀ) and upper − q_k (J = −e_kᵀ);
+/// - ball joint with swing/twist limits (Joint::ball_limit, Annex D.2, swing_twist.hpp): one swing
+///   row d_s (ellipse, rad) and two twist rows θ_t − lower, upper − θ_t, on the ball's 3 velocity
+///   columns (ω, body); past kSwingSingular only the radial swing row (the twist is undefined at π);
+/// - ball joint without them: the boxes on its rotation-vector components, J = ±row of Jr(q)⁻¹;
+/// a row is added (unilateral, source kJointLimit / kSwing / kTwist, recovery_speed from the
+/// options) when min(d, d + δt J q̇_free) < activation. The solver's LCP keeps d + δt J q̇ ≥ 0: the
+/// limit holds to first order in δt at the next step. No allocation in addRows()/solved().
+class JointLimitRows final : public RowProducer {
+ public:
+  /// \throws std::invalid_argument on non-finite or negative options or system < 0.
+  JointLimitRows(const control::Controller& controller, int system, JointLimitOptions options = {});
+
+  const char* name() const override { return "joint_limits"; }
+  void addRows(int id, double dt, RowSet& rows) override;
+  void solved(int id, const RowSet& rows) override;
+
+  /// Rows of the last step with their λ (after solved()).
+  const std::vector<LimitRow>& rows() const { return rows_; }
+  /// Rows with λ > 0 at the last step.
+  int activeCount() const;
+  /// max over every limited coordinate (and swing/twist) of how far q_k is past its limit (rad, ≥ 0),
+  /// at the last addRows().
+  double worstExcess() const { return worst_excess_; }
+  const JointLimitOptions& options() const { return options_; }
+  int system() const { return system_; }
+
+ private:
+  struct Box {  // a revolute coordinate or a component of a ball without swing/twist limits
+    int q = -1, v = -1, component = -1, ball_q = -1;
+    double lower = 0, upper = 0;
+  };
+  void add(int id, double dt, RowSet& rows, RowSource source, int coordinate, bool upper, double d,
+           int v, int ncols, const double* jac);
+  const control::Controller* ctl_;
+  int system_;
+  JointLimitOptions options_;
+  std::vector<Box> boxes_;
+  std::vector<int> balls_;  // joints with swing/twist limits
+  std::vector<LimitRow> rows_;
+  double worst_excess_ = 0.0;
+};
+
+/// The joint limits as a stand-alone stage 2 (its own LCP; before the shared ConstraintSolver).
+/// Box limits on every coordinate, ball components included (no swing/twist): use JointLimitRows in
+/// the ConstraintSolver for those.
 class JointLimits {
  public:
   /// \throws std::invalid_argument on non-finite or negative options.

@@ -1,0 +1,42 @@
+#pragma once
+/// \file system.hpp
+/// \brief A system the constraint rows act on: first-order dynamics b q̇ = Γ (thesis 2.4), split in
+/// the three stages of Alg. 4 — free motion, constraint forces, integration.
+///
+/// The solver only needs, at q_k after the free motion: nv, q̇_free, the action of b⁻¹ on columns
+/// (b's Cholesky factor), and a way to add a constraint torque (q̇ = q̇_free + b⁻¹Γ_c). Implementations:
+/// MannequinSystem (a control::Controller, below) and sim's rigid objects.
+#include <Eigen/Dense>
+
+#include "mannequin/control/controller.hpp"
+
+namespace mannequin::constraints {
+
+class ConstrainedSystem {
+ public:
+  virtual ~ConstrainedSystem() = default;
+  virtual int nv() const = 0;
+  /// q̇_free (nv) of the current step (after the free-motion stage).
+  virtual const Eigen::VectorXd& qdotFree() const = 0;
+  /// b's Cholesky factor L (b = L Lᵀ, nv × nv, lower) of the current step.
+  virtual const Eigen::LLT<Eigen::MatrixXd>& frictionLLT() const = 0;
+  /// Adds b⁻¹Γ_c to q̇ (Γ_c: nv, generalised force of the constraints).
+  virtual void applyConstraintForce(const Eigen::VectorXd& gamma_c) = 0;
+};
+
+/// A mannequin's controller as a constrained system (stage 2 of control::Controller).
+class MannequinSystem final : public ConstrainedSystem {
+ public:
+  explicit MannequinSystem(control::Controller& controller) : ctl_(&controller) {}
+  int nv() const override { return ctl_->model().nv; }
+  const Eigen::VectorXd& qdotFree() const override { return ctl_->qdotFree(); }
+  const Eigen::LLT<Eigen::MatrixXd>& frictionLLT() const override { return ctl_->apparentFrictionLLT(); }
+  void applyConstraintForce(const Eigen::VectorXd& gamma_c) override { ctl_->applyConstraintForce(gamma_c); }
+  control::Controller& controller() { return *ctl_; }
+  const control::Controller& controller() const { return *ctl_; }
+
+ private:
+  control::Controller* ctl_;
+};
+
+}  // namespace mannequin::constraints

@@ -1,0 +1,293 @@
+#include "mannequin/constraints/solver.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace mannequin::constraints {
+
+const char* solverUsedName(SolverUsed s) {
+  switch (s) {
+    case SolverUsed::kNone: return "none";
+    case SolverUsed::kLemke: return "lemke";
+    case SolverUsed::kStructured: return "structured";
+    case SolverUsed::kPgs: return "pgs";
+    case SolverUsed::kFailed: return "failed";
+  }
+  return "failed";
+}
+
+namespace {
+
+using Clock = std::chrono::steady_clock;
+constexpr int kPanel = 64;  // column panels of the Delassus assembly
+
+double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+std::vector<int> systemSizes(const std::vector<ConstrainedSystem*>& systems, const SolverOptions& o) {
+  if (systems.empty()) throw std::invalid_argument("ConstraintSolver: no system");
+  if (systems.size() > 64) throw std::invalid_argument("ConstraintSolver: more than 64 systems");
+  if (o.max_rows < 1 || o.max_friction_rows < 0 || o.max_friction_rows > o.max_rows || o.max_edges < 1)
+    throw std::invalid_argument(
+        "ConstraintSolver: options need max_rows >= 1, 0 <= max_friction_rows <= max_rows, max_edges >= 1");
+  std::vector<int> nv;
+  for (std::size_t s = 0; s < systems.size(); ++s) {
+    if (systems[s] == nullptr) throw std::invalid_argument("ConstraintSolver: system " + std::to_string(s) + " is null");
+    nv.push_back(systems[s]->nv());
+  }
+  return nv;
+}
+
+}  // namespace
+
+// LCP layout of a step: z = [normal/limit rows and bilateral halves (nN) | friction edges (nE) |
+// sliding speeds γ (nG)]; the force rows are the first nF = nN + nE. Buffers whose size is linear in
+// the capacity are allocated here; the n²-sized ones (M, Lemke's tableau, PGS's Mᵀ) grow to the
+// largest LCP seen (never beyond the capacity), so solve() allocates nothing after that warm-up.
+struct ConstraintSolver::Impl {
+  using Index = Eigen::Index;
+  int cap_n = 0, cap_f = 0, cap_nn = 0;  // LCP, force rows, frictionless rows
+  int m_total = 0;                       // Σ nv_s
+  std::vector<Eigen::MatrixXd> R;        // per system: cap_f × nv_s, force rows R_s
+  std::vector<Eigen::MatrixXd> X;        // per system: nv_s × cap_f, L_s⁻¹ R_sᵀ
+  std::vector<Eigen::VectorXd> gamma;    // per system: nv_s, Γ_s
+  std::vector<int> pos, neg, edge, gam;  // per row: index of λ (+ half), − half, first edge, γ
+  Eigen::MatrixXd M;                     // grows: n × n
+  Eigen::VectorXd q;                     // cap_n
+  Eigen::MatrixXd A;                     // cap_nn × Σ nv_s: frictionless A = [R_s L_s⁻ᵀ]_s
+  lcp::LcpResult result;                 // cap_n
+  lcp::LemkeWorkspace lemke;
+  lcp::StructuredWorkspace structured;
+  lcp::PgsWorkspace pgs;
+  Index grown = 0;                       // n² buffers hold this size
+
+  void grow(Index n) {
+    if (n <= grown) return;
+    const Index g = std::min<Index>(cap_n, std::max<Index>(n, 2 * grown));
+    M.resize(g, g);
+    lemke.reserve(g);
+    pgs.reserve(std::min<Index>(g, cap_nn));
+    grown = g;
+  }
+};
+
+ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, const SolverOptions& options)
+    : impl_(std::make_unique<Impl>()),
+      systems_(std::move(systems)),
+      options_(options),
+      rows_(systemSizes(systems_, options), options.max_rows, options.max_friction_rows, options.max_edges) {
+  Impl& im = *impl_;
+  im.cap_nn = 2 * options.max_rows;  // a bilateral row is two LCP rows
+  im.cap_f = im.cap_nn + options.max_friction_rows * options.max_edges;
+  im.cap_n = im.cap_f + options.max_friction_rows;
+  for (ConstrainedSystem* s : systems_) {
+    const int nv = s->nv();
+    im.R.emplace_back(Eigen::MatrixXd::Zero(im.cap_f, nv));
+    im.X.emplace_back(Eigen::MatrixXd::Zero(nv, im.cap_f));
+    im.gamma.emplace_back(Eigen::VectorXd::Zero(nv));
+    im.m_total += nv;
+  }
+  const auto mr = static_cast<std::size_t>(options.max_rows);
+  im.pos.assign(mr, -1);
+  im.neg.assign(mr, -1);
+  im.edge.assign(mr, -1);
+  im.gam.assign(mr, -1);
+  im.q = Eigen::VectorXd::Zero(im.cap_n);
+  im.A = Eigen::MatrixXd::Zero(im.cap_nn, im.m_total);
+  im.result.reserve(im.cap_n);
+  im.structured.reserve(im.cap_nn, im.m_total);
+  producers_.reserve(16);
+}
+
+ConstraintSolver::~ConstraintSolver() = default;
+
+int ConstraintSolver::addProducer(RowProducer* producer) {
+  if (producer == nullptr) throw std::invalid_argument("ConstraintSolver::addProducer: null producer");
+  producers_.push_back(producer);
+  return static_cast<int>(producers_.size()) - 1;
+}
+
+const SolveReport& ConstraintSolver::solve(double dt) {
+  Impl& im = *impl_;
+  SolveReport& rep = report_;
+  rep = SolveReport{};
+  const auto t0 = Clock::now();
+  if (!(dt > 0.0) || !std::isfinite(dt)) {  // no rows at a meaningless step
+    rep.solver = SolverUsed::kFailed;
+    rep.fallback = true;
+    rep.dropped = rows_.dropped();
+    ++failures_;
+    ++unsolved_;
+    return rep;
+  }
+
+  // 1. rows
+  rows_.clear();
+  for (std::size_t p = 0; p < producers_.size(); ++p) producers_[p]->addRows(static_cast<int>(p), dt, rows_);
+  const int nr = rows_.size();
+  const int ns = rows_.numSystems();
+  rep.rows = nr;
+  rep.dropped = rows_.dropped();
+  const auto t1 = Clock::now();
+  rep.produce_s = seconds(t0, t1);
+  if (nr == 0) {
+    for (std::size_t p = 0; p < producers_.size(); ++p) producers_[p]->solved(static_cast<int>(p), rows_);
+    return rep;
+  }
+  // 2. assembly: indices
+  int nN = 0, nE = 0, nG = 0;
+  std::uint64_t touched = 0;
+  for (int r = 0; r < nr; ++r) {
+    const RowInfo& in = rows_.info(r);
+    const auto ur = static_cast<std::size_t>(r);
+    im.pos[ur] = nN++;
+    im.neg[ur] = in.kind == RowKind::kBilateral ? nN++ : -1;
+    for (int s = 0; s < ns; ++s) touched |= rows_.touches(r, s) ? std::uint64_t{1} << s : 0;
+  }
+  for (int r = 0; r < nr; ++r) {
+    const auto ur = static_cast<std::size_t>(r);
+    if (rows_.frictionSlot(r) >= 0) {
+      im.edge[ur] = nN + nE;
+      nE += rows_.info(r).friction_edges;
+      ++nG;
+    } else {
+      im.edge[ur] = -1;
+    }
+  }
+  const int nF = nN + nE, n = nF + nG;
+  for (int r = 0, g = 0; r < nr; ++r) im.gam[static_cast<std::size_t>(r)] = rows_.frictionSlot(r) >= 0 ? nF + g++ : -1;
+  im.grow(n);
+  auto M = im.M.topLeftCorner(n, n);
+  auto q = im.q.head(n);
+  M.setZero();
+  q.setZero();
+  // force rows per touched system, Delassus A = Σ_s R_s b_s⁻¹ R_sᵀ = Σ_s X_sᵀ X_s, q = R q̇_free + d/δt
+  int col = 0;
+  for (int s = 0; s < ns; ++s) {
+    if (!((touched >> s) & 1u)) continue;
+    const auto us = static_cast<std::size_t>(s);
+    const Eigen::MatrixXd& J = rows_.jacobians(s);
+    auto R = im.R[us].topRows(nF);
+    for (int r = 0; r < nr; ++r) {
+      const auto ur = static_cast<std::size_t>(r);
+      R.row(im.pos[ur]) = J.row(r);
+      if (im.neg[ur] >= 0) R.row(im.neg[ur]) = -J.row(r);
+      const int slot = rows_.frictionSlot(r);
+      if (slot < 0) continue;
+      const int m = rows_.info(r).friction_edges;
+      for (int k = 0; k < m; ++k) {
+        const double th = 2.0 * std::numbers::pi * k / m;
+        R.row(im.edge[ur] + k) = std::cos(th) * rows_.tangents(s, 0).row(slot) + std::sin(th) * rows_.tangents(s, 1).row(slot);
+      }
+    }
+    auto X = im.X[us].leftCols(nF);
+    X = R.transpose();
+    // in panels of kPanel columns: Eigen's blocked kernels then keep their packing buffers on the
+    // stack (under EIGEN_STACK_ALLOCATION_LIMIT) instead of allocating them for large n
+    const auto L = systems_[us]->frictionLLT().matrixL();
+    for (int c0 = 0; c0 < nF; c0 += kPanel) {
+      auto Xc = X.middleCols(c0, std::min(kPanel, nF - c0));
+      L.solveInPlace(Xc);  // L⁻¹ Rᵀ
+    }
+    for (int i0 = 0; i0 < nF; i0 += kPanel) {
+      const int ni = std::min(kPanel, nF - i0);
+      for (int j0 = i0; j0 < nF; j0 += kPanel) {
+        const int nj = std::min(kPanel, nF - j0);
+        M.block(i0, j0, ni, nj).noalias() += X.middleCols(i0, ni).transpose() * X.middleCols(j0, nj);
+        if (j0 != i0) M.block(j0, i0, nj, ni) = M.block(i0, j0, ni, nj).transpose();
+      }
+    }
+    q.head(nF).noalias() += R * systems_[us]->qdotFree();
+    const int nv = static_cast<int>(X.rows());
+    im.A.block(0, col, nN, nv) = X.leftCols(nN).transpose();  // frictionless A = [R_s L_s⁻ᵀ]_s
+    col += nv;
+  }
+  for (int r = 0; r < nr; ++r) {
+    const RowInfo& in = rows_.info(r);
+    const auto ur = static_cast<std::size_t>(r);
+    const double v = std::isfinite(in.recovery_speed) ? std::max(0.0, in.recovery_speed) : 0.0;
+    q[im.pos[ur]] += std::max(in.distance / dt, -v);
+    if (im.neg[ur] >= 0) q[im.neg[ur]] += std::max(-in.distance / dt, -v);
+    if (im.gam[ur] < 0) continue;
+    // edges: w = t_k q̇ + γ; cone: w_γ = μλ − Σβ
+    const int m = in.friction_edges, g = im.gam[ur], p = im.pos[ur];
+    M(g, p) = in.mu;
+    for (int k = 0; k < m; ++k) {
+      M(im.edge[ur] + k, g) = 1.0;
+      M(g, im.edge[ur] + k) = -1.0;
+    }
+  }
+  const auto t2 = Clock::now();
+  rep.assemble_s = seconds(t1, t2);
+  rep.lcp_size = n;
+
+  // 3. Lemke, then the frictionless problem by the structured solver, then PGS
+  lcp::LcpResult& res = im.result;
+  int nz = 0;  // force rows of the answer
+  const lcp::LcpStatus ls = lcp::solveLemke(M, q, im.lemke, options_.lemke, res);
+  rep.lemke_status = ls;
+  rep.pivots = res.pivots;
+  if (ls == lcp::LcpStatus::Solved && res.z.head(n).allFinite()) {
+    rep.solver = SolverUsed::kLemke;
+    nz = nF;
+  } else {
+    rep.fallback = true;
+    ++failures_;
+    rep.lcp_size = nN;
+    const auto An = im.A.topLeftCorner(nN, col);
+    const auto qn = im.q.head(nN);
+    if (lcp::solveStructured(An, qn, im.structured, options_.structured, res) == lcp::LcpStatus::Solved &&
+        res.z.head(nN).allFinite()) {
+      rep.solver = SolverUsed::kStructured;
+      nz = nN;
+    } else if (lcp::solvePgs(im.M.topLeftCorner(nN, nN), qn, im.pgs, options_.pgs, res) == lcp::LcpStatus::Solved &&
+               res.z.head(nN).allFinite()) {
+      rep.solver = SolverUsed::kPgs;
+      nz = nN;
+    } else {
+      rep.solver = SolverUsed::kFailed;
+      ++unsolved_;
+    }
+    rep.pivots = res.pivots;
+  }
+  const auto z = res.z.head(std::max(nz, 0));
+
+  // 4. forces back to the systems and the rows
+  if (nz > 0) {
+    for (int s = 0; s < ns; ++s) {
+      if (!((touched >> s) & 1u)) continue;
+      const auto us = static_cast<std::size_t>(s);
+      im.gamma[us].noalias() = im.R[us].topRows(nz).transpose() * z;
+      systems_[us]->applyConstraintForce(im.gamma[us]);
+    }
+  }
+  for (int r = 0; r < nr; ++r) {
+    RowInfo& in = rows_.info(r);
+    const auto ur = static_cast<std::size_t>(r);
+    if (nz == 0) {
+      in.lambda = in.friction = 0.0;
+      continue;
+    }
+    const double plus = z[im.pos[ur]], minus = im.neg[ur] >= 0 ? z[im.neg[ur]] : 0.0;
+    in.lambda = plus - minus;
+    rep.active += (plus > 0.0 || minus > 0.0) ? 1 : 0;
+    in.friction = 0.0;
+    if (im.edge[ur] >= 0 && nz == nF) {
+      const int m = in.friction_edges;
+      double fx = 0.0, fy = 0.0;
+      for (int k = 0; k < m; ++k) {
+        const double th = 2.0 * std::numbers::pi * k / m;
+        fx += z[im.edge[ur] + k] * std::cos(th);
+        fy += z[im.edge[ur] + k] * std::sin(th);
+      }
+      in.friction = std::hypot(fx, fy);
+    }
+  }
+  rep.solve_s = seconds(t2, Clock::now());
+  for (std::size_t p = 0; p < producers_.size(); ++p) producers_[p]->solved(static_cast<int>(p), rows_);
+  return rep;
+}
+
+}  // namespace mannequin::constraints
