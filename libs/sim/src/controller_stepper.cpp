@@ -78,13 +78,19 @@ void ControllerStepper::reset(const skeleton::VectorX& q) {
   skeleton::centerOfMass(model_, data_);
 }
 
-bool ControllerStepper::step(double dt) {
+bool ControllerStepper::step(double dt) { return beginStep(dt, true) && endStep(); }
+
+bool ControllerStepper::beginStep(double dt, bool own_limits) {
   if (std::abs(dt - dt_) > 1e-12 * dt_)
     throw std::logic_error("controller stepper: step " + std::to_string(dt) + " s, built for " + std::to_string(dt_) + " s");
   if (controller_->computeFreeMotion() != control::StepStatus::kOk) return false;
   // unilateral constraints (Alg. 4): their force joins q̇ before the integration; a failed LCP leaves
   // the step unconstrained (counted in jointLimits()->failures())
-  if (limits_) limits_->apply(*controller_);
+  if (own_limits && limits_) limits_->apply(*controller_);
+  return true;
+}
+
+bool ControllerStepper::endStep() {
   controller_->integrate();
   if (!controller_->q().allFinite()) return false;
   skeleton::forwardKinematics(model_, data_, controller_->q());

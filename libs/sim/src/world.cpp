@@ -1,6 +1,8 @@
 #include "mannequin/sim/world.hpp"
 
 #include <algorithm>
+#include <chrono>
+#include <limits>
 #include <cmath>
 #include <set>
 #include <stdexcept>
@@ -10,6 +12,72 @@
 #include "mannequin/skeleton/anthropometry.hpp"
 
 namespace mannequin::sim {
+
+namespace {
+/// A foot touches the floor when it is pressed (λ > 0) or its margin shell is within this of the floor's (m).
+constexpr double kFootContactTolerance = 0.005;
+
+/// max over limited coordinates of how far q is past a limit (rad, ≥ 0); ball coordinates are the
+/// rotation-vector components the model's boxes bound.
+double worstLimitExcess(const skeleton::Model& model, const skeleton::VectorX& q) {
+  double worst = 0.0;
+  for (const skeleton::Joint& j : model.joints) {
+    if (j.type == skeleton::JointType::kFreeFlyer) continue;
+    for (int c = 0; c < j.nq; ++c) {
+      const int k = j.idx_q + c;
+      const double lo = model.lower_limit(k), hi = model.upper_limit(k);
+      if (std::isfinite(lo)) worst = std::max(worst, lo - q(k));
+      if (std::isfinite(hi)) worst = std::max(worst, q(k) - hi);
+    }
+  }
+  return worst;
+}
+}  // namespace
+
+namespace {
+/// Segment pairs of a mannequin already within the activation distance of each other (margins
+/// included) in its standing configuration — thighs side by side, arms along the trunk. They are
+/// excluded from its self contacts: at calibration they would start inside each other's margins and
+/// the contact rows would fight the posture for the whole session (docs/constraints.md).
+std::vector<std::pair<std::string, std::string>> touchingWhenStanding(const skeleton::Model& model,
+                                                                      const collision::MannequinOptions& options,
+                                                                      double activation) {
+  collision::WorldOptions wo;
+  wo.activation_distance = activation;
+  collision::CollisionWorld cw(wo);
+  const int mi = cw.addMannequin(model, options);
+  skeleton::Data d(model);
+  skeleton::forwardKinematics(model, d, skeleton::standingConfiguration(model));
+  cw.updateMannequin(mi, d);
+  collision::ContactSet set;
+  cw.query(0, set);
+  std::vector<std::pair<std::string, std::string>> pairs = options.exclude_pairs;
+  for (const collision::Contact& c : set.contacts) {
+    std::string a = cw.bodyName(c.body_a), b = cw.bodyName(c.body_b);
+    a = a.substr(a.find('/') + 1);
+    b = b.substr(b.find('/') + 1);
+    if (std::find(pairs.begin(), pairs.end(), std::make_pair(a, b)) == pairs.end()) pairs.emplace_back(a, b);
+  }
+
+  return pairs;
+}
+}  // namespace
+
+struct World::Physics {
+  collision::CollisionWorld cw;
+  std::vector<int> cw_mannequin;                       // per mannequin: index in cw
+  std::vector<std::unique_ptr<constraints::MannequinSystem>> systems;
+  std::vector<std::unique_ptr<constraints::MannequinFrames>> frames;
+  std::unique_ptr<constraints::ContactRows> contacts;
+  std::vector<std::unique_ptr<constraints::JointLimitRows>> limits;  // per mannequin (joint_limits on)
+  std::unique_ptr<constraints::ConstraintSolver> solver;
+  collision::ContactSet set;
+  int floor_body = -1;                                 // "scene/floor", −1 if none
+  std::vector<int> body_mannequin;                     // per body: mannequin index or −1
+  std::vector<char> body_is_foot;                      // per body: a foot segment ("foot*", "toes*")
+  std::vector<char> stepping;                          // per mannequin: stage 1 succeeded this step
+  explicit Physics(const collision::WorldOptions& o) : cw(o) {}
+};
 
 struct World::Mannequin {
   std::string name;
@@ -52,6 +120,11 @@ World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : conf
     m->weights.assign(m->frames.size(), 0.0);
     m->q_standing = skeleton::standingConfiguration(m->model);
     m->frame_indices = idx;
+    if (s.controller && config_.physics.enabled) {
+      if (!config_.physics.gravity.allFinite())
+        throw std::invalid_argument("sim: physics.gravity must be finite");
+      s.controller->gravity = config_.physics.gravity;
+    }
     if (s.controller) {
       try {
         m->stepper = std::make_unique<ControllerStepper>(m->model, *s.controller, idx, config_.step, m->q_standing,
@@ -67,6 +140,103 @@ World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : conf
     for (auto& st : m->frames) st.target = st.actual = m->stepper->data().oMf[st.frame_index];
     mannequins_.push_back(std::move(m));
   }
+  mannequin_diagnostics_.assign(mannequins_.size(), MannequinDiagnostics{});
+  if (config_.physics.enabled) buildPhysics();
+}
+
+void World::buildPhysics() {
+  const PhysicsConfig& pc = config_.physics;
+  if (!(pc.segment_margin >= 0) || !std::isfinite(pc.segment_margin))
+    throw std::invalid_argument("sim: physics.segment_margin must be finite and >= 0");
+  if (pc.query_period_steps < 1) throw std::invalid_argument("sim: physics.query_period_steps must be >= 1");
+  if (!(pc.activation_distance > 0) || !std::isfinite(pc.activation_distance))
+    throw std::invalid_argument("sim: physics.activation_distance must be finite and > 0");
+  collision::WorldOptions wo;
+  wo.activation_distance = pc.activation_distance;
+  physics_ = std::make_unique<Physics>(wo);
+  Physics& P = *physics_;
+  collision::SceneSpec scene = pc.scene;
+  scene.activation_distance = pc.activation_distance;  // the physics' candidates, not the scene file's display range
+  P.cw.addScene(scene);
+  std::vector<constraints::ConstrainedSystem*> systems;
+  for (auto& mp : mannequins_) {
+    auto* cs = dynamic_cast<ControllerStepper*>(mp->stepper.get());
+    if (cs == nullptr)
+      throw std::invalid_argument("sim: mannequin '" + mp->name + "': physics needs the controller stepper (stepper: controller)");
+    collision::MannequinOptions mo;
+    mo.name = mp->name;
+    mo.margin = pc.segment_margin;
+    mo.self_collision = pc.self_collision;
+    mo.exclude_pairs = touchingWhenStanding(mp->model, mo, pc.activation_distance);
+    P.cw_mannequin.push_back(P.cw.addMannequin(mp->model, mo));
+    P.systems.push_back(std::make_unique<constraints::MannequinSystem>(cs->controller()));
+    P.frames.push_back(std::make_unique<constraints::MannequinFrames>(mp->model, cs->controller().data()));
+    systems.push_back(P.systems.back().get());
+  }
+  // materials: the scene's, then the segments'; μ from the scene's table (default_mu elsewhere)
+  std::vector<std::string> materials{scene.default_material};
+  const auto material = [&](const std::string& name) {
+    for (std::size_t i = 0; i < materials.size(); ++i)
+      if (materials[i] == name) return static_cast<int>(i);
+    materials.push_back(name);
+    return static_cast<int>(materials.size()) - 1;
+  };
+  const int n = P.cw.bodyCount();
+  std::vector<constraints::BodyBinding> bindings(static_cast<std::size_t>(n));
+  P.body_mannequin.assign(static_cast<std::size_t>(n), -1);
+  P.body_is_foot.assign(static_cast<std::size_t>(n), 0);
+  for (int b = 0; b < n; ++b) {
+    constraints::BodyBinding& bb = bindings[static_cast<std::size_t>(b)];
+    bb.margin = P.cw.margin(b);
+    bb.static_pose = P.cw.bodyPose(b);
+    const std::string& bname = P.cw.bodyName(b);
+    if (bname == "scene/floor") P.floor_body = b;
+    for (const collision::BodySpec& bs : scene.bodies)
+      if ("scene/" + bs.name == bname) bb.material = material(bs.material);
+  }
+  const int seg_material = material(pc.segment_material);
+  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+    const skeleton::Model& model = mannequins_[m]->model;
+    for (std::size_t sgi = 0; sgi < model.segments.size(); ++sgi) {
+      const int b = P.cw.segmentBody(P.cw_mannequin[m], static_cast<int>(sgi));
+      if (b < 0) continue;
+      constraints::BodyBinding& bb = bindings[static_cast<std::size_t>(b)];
+      bb.system = static_cast<int>(m);
+      bb.frames = P.frames[m].get();
+      bb.local = model.segments[sgi].joint;
+      bb.material = seg_material;
+      P.body_mannequin[static_cast<std::size_t>(b)] = static_cast<int>(m);
+      const std::string& sn = model.segments[sgi].name;
+      P.body_is_foot[static_cast<std::size_t>(b)] = sn.rfind("foot", 0) == 0 || sn.rfind("toes", 0) == 0;
+    }
+  }
+  constraints::ContactOptions co = pc.contacts;
+  const int nm = static_cast<int>(materials.size());
+  co.mu = Eigen::MatrixXd::Constant(nm, nm, scene.default_mu);
+  for (const collision::FrictionPair& fp : scene.friction) {
+    const int a = material(fp.a), b = material(fp.b);
+    if (a >= co.mu.rows() || b >= co.mu.rows()) continue;  // a material no body uses
+    co.mu(a, b) = co.mu(b, a) = fp.mu;
+  }
+  P.contacts = std::make_unique<constraints::ContactRows>(std::move(bindings), co);
+  P.solver = std::make_unique<constraints::ConstraintSolver>(systems, pc.solver);
+  // the joint limits (and swing/twist) in the same LCP as the contacts: each sees the other's force
+  if (config_.joint_limits)
+    for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+      auto& cs = static_cast<ControllerStepper&>(*mannequins_[m]->stepper);
+      P.limits.push_back(std::make_unique<constraints::JointLimitRows>(cs.controller(), static_cast<int>(m), *config_.joint_limits));
+      P.solver->addProducer(P.limits.back().get());
+    }
+  P.solver->addProducer(P.contacts.get());
+  P.stepping.assign(mannequins_.size(), 0);
+  P.set.contacts.reserve(static_cast<std::size_t>(pc.solver.max_rows));
+  contacts_.reserve(static_cast<std::size_t>(pc.solver.max_rows));
+}
+
+const collision::CollisionWorld* World::collisionWorld() const { return physics_ ? &physics_->cw : nullptr; }
+const constraints::ConstraintSolver* World::constraintSolver() const { return physics_ ? physics_->solver.get() : nullptr; }
+const MannequinDiagnostics& World::mannequinDiagnostics(int m) const {
+  return mannequin_diagnostics_.at(static_cast<std::size_t>(m));
 }
 
 World::~World() = default;
@@ -133,6 +303,14 @@ void World::calibrate(Mannequin& m, const mocap::Frame& frame) {
     }
     qc = fit.q();
   }
+  if (physics_) {
+    // the contact–control paradox (thesis 4.4.3): a foot target calibrated below the floor would press
+    // the sole into it for the whole session. Put the lowest sole's margin shell of q_c at
+    // `calibration_clearance` above the floor's, so the foot targets at the calibration pose rest on
+    // the floor (the sole `margins + clearance` above it), not in it.
+    const double gap = soleGap(m, qc);
+    if (std::isfinite(gap)) qc(2) += config_.physics.calibration_clearance - gap;
+  }
   m.stepper->reset(qc);
   m.stepper->setPosture(qc);
   std::fill(m.have_previous.begin(), m.have_previous.end(), false);
@@ -144,6 +322,29 @@ void World::calibrate(Mannequin& m, const mocap::Frame& frame) {
   }
   std::fill(m.weights.begin(), m.weights.end(), 1.0);
   m.calibrated = true;
+}
+
+double World::soleGap(Mannequin& m, const skeleton::VectorX& q) {
+  Physics& P = *physics_;
+  std::size_t index = 0;
+  while (mannequins_[index].get() != &m) ++index;
+  skeleton::Data d(m.model);
+  skeleton::forwardKinematics(m.model, d, q);
+  const double activation = P.cw.activationDistance();
+  P.cw.setActivationDistance(2.0);  // the soles may be far above or below the floor here
+  P.cw.updateMannequin(P.cw_mannequin[index], d);
+  collision::ContactSet set;
+  P.cw.query(steps_, set);
+  P.cw.setActivationDistance(activation);
+  double gap = std::numeric_limits<double>::infinity();
+  for (const collision::Contact& c : set.contacts) {
+    const bool foot_floor = (c.body_a == P.floor_body && P.body_is_foot[static_cast<std::size_t>(c.body_b)] &&
+                             P.body_mannequin[static_cast<std::size_t>(c.body_b)] == static_cast<int>(index)) ||
+                            (c.body_b == P.floor_body && P.body_is_foot[static_cast<std::size_t>(c.body_a)] &&
+                             P.body_mannequin[static_cast<std::size_t>(c.body_a)] == static_cast<int>(index));
+    if (foot_floor) gap = std::min(gap, c.distance);  // after margins: 0 = the margin shells touch
+  }
+  return gap;
 }
 
 void World::addMocap(const mocap::Frame& frame) {
@@ -169,41 +370,155 @@ math::Vector6 World::targetTwist(Mannequin& m, std::size_t i, double dt) const {
   return V;
 }
 
+void World::driveTargets(Mannequin& m, std::int64_t t, double dt) {
+  if (m.calibrated && anchored_) {
+    for (std::size_t i = 0; i < m.frames.size(); ++i) {
+      DrivenFrame& st = m.frames[i];
+      const BodySample s = buffer_.sample(st.body, t);
+      double goal = 1.0;
+      if (s.tracked) {
+        st.target = s.pose * st.offset;
+      } else {
+        const double since = static_cast<double>(t - s.last_tracked_ns) * 1e-9;
+        if (s.ever_tracked) st.target = s.pose * st.offset;  // hold the last tracked pose
+        goal = since <= config_.occlusion_hold
+                   ? 1.0
+                   : std::max(0.0, 1.0 - (since - config_.occlusion_hold) / std::max(config_.occlusion_blend, 1e-9));
+      }
+      st.tracked = s.tracked;
+      // weights move towards their goal at 1/blend per second (back in after an occlusion: no jump)
+      const double rate = dt / std::max(config_.occlusion_blend, 1e-9);
+      double& w = m.weights[i];
+      w = goal > w ? std::min(goal, w + rate) : goal;
+      m.stepper->setTarget(static_cast<int>(i), st.target, targetTwist(m, i, dt), w);
+    }
+  } else {
+    for (std::size_t i = 0; i < m.frames.size(); ++i)
+      m.stepper->setTarget(static_cast<int>(i), m.frames[i].target, math::Vector6::Zero(), 0.0);
+  }
+}
+
+namespace {
+double seconds(std::chrono::steady_clock::time_point a, std::chrono::steady_clock::time_point b) {
+  return std::chrono::duration<double>(b - a).count();
+}
+}  // namespace
+
+bool World::physicsStep() {
+  using Clock = std::chrono::steady_clock;
+  Physics& P = *physics_;
+  const double dt = config_.step;
+  bool ok = true;
+  const auto t0 = Clock::now();
+  // stage 1: free motion of every mannequin at q_k (kinematics and Jacobians at q_k in its controller)
+  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+    auto& cs = static_cast<ControllerStepper&>(*mannequins_[m]->stepper);
+    P.stepping[m] = cs.beginStep(dt, /*own_limits=*/false) ? 1 : 0;  // the limits are rows of the shared LCP
+    if (!P.stepping[m]) {
+      ok = false;
+      ++failed_steps_;
+    }
+  }
+  const auto t1 = Clock::now();
+  // contacts at q_k: a query every query_period_steps; in between, the last query's witness points are
+  // re-evaluated at q_k by the contact rows
+  if (steps_ % static_cast<std::uint64_t>(config_.physics.query_period_steps) == 0) {
+    for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+      auto& cs = static_cast<ControllerStepper&>(*mannequins_[m]->stepper);
+      P.cw.updateMannequin(P.cw_mannequin[m], cs.controller().data());
+    }
+    P.cw.query(steps_, P.set);
+    P.contacts->setContacts(P.set);
+  }
+  const auto t2 = Clock::now();
+  // stage 2: every row in one LCP (systems that failed stage 1 get no force: their q̇ is zero)
+  diagnostics_.solver = P.solver->solve(dt);
+  const auto t3 = Clock::now();
+  // stage 3: integration, kinematics at q_{k+1}
+  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+    auto& cs = static_cast<ControllerStepper&>(*mannequins_[m]->stepper);
+    if (P.stepping[m] && !cs.endStep()) {
+      ok = false;
+      ++failed_steps_;
+    }
+  }
+  const auto t4 = Clock::now();
+  diagnostics_.free_motion_s = seconds(t0, t1);
+  diagnostics_.collision_s = seconds(t1, t2);
+  diagnostics_.constraints_s = seconds(t2, t3);
+  diagnostics_.integrate_s = seconds(t3, t4);
+  // diagnostics of the step (contacts as solved at q_k)
+  const auto& cts = P.contacts->contacts();
+  const auto& states = P.contacts->states();
+  contacts_.clear();
+  diagnostics_.contacts = 0;
+  diagnostics_.active_contacts = 0;
+  diagnostics_.max_penetration_m = P.contacts->maxPenetration();
+  for (MannequinDiagnostics& md : mannequin_diagnostics_) {
+    md.contacts = 0;
+    md.foot_contact = false;
+    md.sole_height_m = std::numeric_limits<double>::infinity();
+  }
+  for (std::size_t i = 0; i < cts.size(); ++i) {
+    const collision::Contact& c = cts[i];
+    const auto& st = states[i];
+    if (st.row < 0) continue;
+    ++diagnostics_.contacts;
+    if (st.normal_force > 0) ++diagnostics_.active_contacts;
+    ContactReport r;
+    r.body_a = c.body_a;
+    r.body_b = c.body_b;
+    r.point = st.point;
+    r.normal = c.normal;
+    r.distance = st.distance;
+    r.normal_force = st.normal_force;
+    r.friction_force = st.friction_force;
+    contacts_.push_back(r);
+    for (const int b : {c.body_a, c.body_b}) {
+      const int m = P.body_mannequin[static_cast<std::size_t>(b)];
+      if (m < 0) continue;
+      MannequinDiagnostics& md = mannequin_diagnostics_[static_cast<std::size_t>(m)];
+      ++md.contacts;
+      const int other = b == c.body_a ? c.body_b : c.body_a;
+      if (P.body_is_foot[static_cast<std::size_t>(b)] && other == P.floor_body) {
+        // real geometry: the distance after margins plus both margins
+        const double gap = st.distance + P.cw.margin(c.body_a) + P.cw.margin(c.body_b);
+        md.sole_height_m = std::min(md.sole_height_m, gap);
+        // touching: pressed, or its margin shell within 1 mm of the floor's
+        if (st.normal_force > 0 || st.distance <= kFootContactTolerance) md.foot_contact = true;
+      }
+    }
+  }
+  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+    MannequinDiagnostics& md = mannequin_diagnostics_[m];
+    // no foot–floor pair in range: the soles are at least the activation distance (plus margins) up
+    if (!std::isfinite(md.sole_height_m)) md.sole_height_m = config_.physics.activation_distance;
+    auto& cs = static_cast<ControllerStepper&>(*mannequins_[m]->stepper);
+    md.worst_joint_limit_excess_rad = worstLimitExcess(mannequins_[m]->model, cs.q());
+  }
+  return ok;
+}
+
 bool World::step() {
   const std::int64_t t = captureTimeNs();
   const double dt = config_.step;
   bool ok = true;
+  for (auto& mp : mannequins_) driveTargets(*mp, t, dt);
+  if (physics_) {
+    ok = physicsStep();
+    diagnostics_.nan = !ok;
+  } else {
+    for (auto& mp : mannequins_)
+      if (!mp->stepper->step(dt)) {
+        ok = false;
+        ++failed_steps_;
+      }
+    diagnostics_.nan = !ok;
+    for (std::size_t m = 0; m < mannequins_.size(); ++m)
+      mannequin_diagnostics_[m].worst_joint_limit_excess_rad = worstLimitExcess(mannequins_[m]->model, mannequins_[m]->stepper->q());
+  }
   for (auto& mp : mannequins_) {
     Mannequin& m = *mp;
-    if (m.calibrated && anchored_) {
-      for (std::size_t i = 0; i < m.frames.size(); ++i) {
-        DrivenFrame& st = m.frames[i];
-        const BodySample s = buffer_.sample(st.body, t);
-        double goal = 1.0;
-        if (s.tracked) {
-          st.target = s.pose * st.offset;
-        } else {
-          const double since = static_cast<double>(t - s.last_tracked_ns) * 1e-9;
-          if (s.ever_tracked) st.target = s.pose * st.offset;  // hold the last tracked pose
-          goal = since <= config_.occlusion_hold
-                     ? 1.0
-                     : std::max(0.0, 1.0 - (since - config_.occlusion_hold) / std::max(config_.occlusion_blend, 1e-9));
-        }
-        st.tracked = s.tracked;
-        // weights move towards their goal at 1/blend per second (back in after an occlusion: no jump)
-        const double rate = dt / std::max(config_.occlusion_blend, 1e-9);
-        double& w = m.weights[i];
-        w = goal > w ? std::min(goal, w + rate) : goal;
-        m.stepper->setTarget(static_cast<int>(i), st.target, targetTwist(m, i, dt), w);
-      }
-    } else {
-      for (std::size_t i = 0; i < m.frames.size(); ++i)
-        m.stepper->setTarget(static_cast<int>(i), m.frames[i].target, math::Vector6::Zero(), 0.0);
-    }
-    if (!m.stepper->step(dt)) {
-      ok = false;
-      ++failed_steps_;
-    }
     const skeleton::Data& d = m.stepper->data();
     for (std::size_t i = 0; i < m.frames.size(); ++i) {
       DrivenFrame& st = m.frames[i];

@@ -40,6 +40,12 @@ class ControllerStepper final : public Stepper {
   void setPosture(const skeleton::VectorX& q_posture) override;
   void reset(const skeleton::VectorX& q) override;
   bool step(double dt) override;
+  /// The step in two halves, for the World's physics (the shared constraint solver runs between them):
+  /// beginStep = stage 1 (free motion at q_k; the controller's data() holds q_k's kinematics and
+  /// Jacobians) and this stepper's own joint limits when `own_limits`; endStep = stage 3 (integration)
+  /// and the kinematics at q_{k+1}. step() = beginStep(dt, true) + endStep().
+  bool beginStep(double dt, bool own_limits);
+  bool endStep();
   const skeleton::VectorX& q() const override { return controller_->q(); }
   const skeleton::VectorX& qdot() const override { return controller_->qdot(); }
   const skeleton::Data& data() const override { return data_; }

@@ -25,13 +25,18 @@
 /// `occlusion_blend` s, so the posture control takes the limb back to the posture target; when the body
 /// is tracked again the weight rises back to 1 over `occlusion_blend` s (no jump).
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "mannequin/sim/mocap_buffer.hpp"
+#include "mannequin/collision/scene.hpp"
+#include "mannequin/collision/world.hpp"
+#include "mannequin/constraints/contacts.hpp"
 #include "mannequin/constraints/joint_limits.hpp"
+#include "mannequin/constraints/solver.hpp"
+#include "mannequin/sim/mocap_buffer.hpp"
 #include "mannequin/control/config.hpp"
 #include "mannequin/sim/stepper.hpp"
 #include "mannequin/sim/tracker.hpp"
@@ -55,6 +60,29 @@ struct MannequinSetup {
   std::optional<control::ControllerConfig> controller;
 };
 
+/// Physics in the loop (thesis Alg. 4): contacts between the mannequins, the scene and the objects as
+/// rows of one LCP per step with the joint limits (and balance, grasps). Needs ControllerSteppers.
+struct PhysicsConfig {
+  bool enabled = false;
+  /// Gravity (m/s², world) of every mannequin's controller when physics is on: the weight comes with
+  /// the contacts that carry it (replaces the controller config's `gravity`).
+  math::Vector3 gravity = math::Vector3(0, 0, -9.81);
+  collision::SceneSpec scene;      ///< static bodies (floor, table ...), materials, μ table
+  double segment_margin = 0.005;   ///< margin of every mannequin segment (m)
+  std::string segment_material = "skin";
+  /// Contacts between the segments of one mannequin (off by default: captured actors pass their hands
+  /// through their own trunk models and cross their feet, and those rows then fight the mocap targets).
+  bool self_collision = false;
+  int query_period_steps = 1;      ///< collision query every N steps (witness points re-evaluated at q_k in between)
+  double activation_distance = 0.02;  ///< m: pairs closer than this become rows (the predictive scheme's candidates)
+  /// The contact–control paradox (thesis 4.4.3): a foot target calibrated slightly below the floor
+  /// would push the sole into it forever. At calibration, targets of frames whose segment touches the
+  /// floor are lifted by the sole's calibration depth plus this clearance (m).
+  double calibration_clearance = 0.002;
+  constraints::ContactOptions contacts;  ///< friction edges, recovery speed (μ from the scene)
+  constraints::SolverOptions solver;
+};
+
 struct SimConfig {
   double step = 0.001;                 ///< δt (s)
   double interpolation_delay = 0.0;    ///< s behind the newest capture time (live mode smoothing)
@@ -70,6 +98,36 @@ struct SimConfig {
   /// Joint limits as unilateral constraints in the ControllerStepper (nullopt: off). The kinematic
   /// tracker always clamps to the limits.
   std::optional<constraints::JointLimitOptions> joint_limits = constraints::JointLimitOptions{};
+  PhysicsConfig physics;
+};
+
+/// One contact after a step's solve, for sim.world and diagnostics (world frame).
+struct ContactReport {
+  int body_a = -1, body_b = -1;       ///< collision body ids (names: World::collisionWorld().bodyName)
+  math::Vector3 point = math::Vector3::Zero();   ///< m, midpoint of the witness points at q_k
+  math::Vector3 normal = math::Vector3::UnitZ(); ///< from a to b
+  double distance = 0.0;        ///< m, after margins (< 0: the margin shells overlap)
+  double normal_force = 0.0;    ///< N
+  double friction_force = 0.0;  ///< N
+};
+
+/// Per mannequin, after a step.
+struct MannequinDiagnostics {
+  int contacts = 0;                 ///< contact rows on this mannequin
+  bool foot_contact = false;        ///< a foot segment touches the floor (distance ≤ activation, λ > 0 or d ≤ 0)
+  double sole_height_m = 0.0;       ///< signed height of the lowest sole point above the floor (real geometry)
+  double balance_distance_m = std::numeric_limits<double>::quiet_NaN();  ///< signed (3.22); NaN: no support
+  double worst_joint_limit_excess_rad = 0.0;  ///< max over coordinates of how far past a limit (≥ 0)
+};
+
+/// What the last step did (thesis Alg. 4 stages), for callers and sim.world.
+struct StepDiagnostics {
+  int contacts = 0;                  ///< contact rows
+  int active_contacts = 0;           ///< with λ > 0
+  double max_penetration_m = 0.0;    ///< deepest penetration of the real geometry (margins excluded), ≥ 0
+  constraints::SolveReport solver;   ///< rows, LCP size, solver used, pivots, fallback
+  bool nan = false;                  ///< a mannequin step produced non-finite numbers (state kept)
+  double collision_s = 0, free_motion_s = 0, constraints_s = 0, integrate_s = 0;  ///< wall time per stage
 };
 
 /// A control frame driven by a mocap body, after a step: the World's calibration (bMf), the target it
@@ -122,9 +180,26 @@ class World {
   const mocap::Frame* latestMocap() const { return buffer_.newest(); }
   std::uint64_t failedSteps() const { return failed_steps_; }
 
+  //---- physics (PhysicsConfig::enabled) ----
+  bool physics() const { return config_.physics.enabled; }
+  /// The collision world of the physics (scene, mannequin segments, objects); nullptr when off.
+  const collision::CollisionWorld* collisionWorld() const;
+  const StepDiagnostics& diagnostics() const { return diagnostics_; }
+  const MannequinDiagnostics& mannequinDiagnostics(int m) const;
+  /// Contacts of the last step (empty when physics is off).
+  const std::vector<ContactReport>& contacts() const { return contacts_; }
+  /// The constraint solver (nullptr when physics is off).
+  const constraints::ConstraintSolver* constraintSolver() const;
+
  private:
   struct Mannequin;
+  struct Physics;
   void calibrate(Mannequin& m, const mocap::Frame& frame);
+  void buildPhysics();
+  /// Distance after margins of mannequin m's lowest sole to the floor at q (m; +inf: no floor).
+  double soleGap(Mannequin& m, const skeleton::VectorX& q);
+  void driveTargets(Mannequin& m, std::int64_t capture_ns, double dt);
+  bool physicsStep();
   math::Vector6 targetTwist(Mannequin& m, std::size_t i, double dt) const;
   std::vector<std::unique_ptr<Mannequin>> mannequins_;
   SimConfig config_;
@@ -133,6 +208,10 @@ class World {
   bool anchored_ = false;
   std::int64_t anchor_capture_ns_ = 0;
   std::uint64_t anchor_step_ = 0;
+  std::unique_ptr<Physics> physics_;
+  StepDiagnostics diagnostics_;
+  std::vector<MannequinDiagnostics> mannequin_diagnostics_;
+  std::vector<ContactReport> contacts_;
 };
 
 }  // namespace mannequin::sim
