@@ -1,15 +1,63 @@
 #include "mannequin/simservice/config.hpp"
 
+#include <filesystem>
+
+#include "mannequin/core/paths.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
 namespace mannequin::simservice {
 
 using core::ConfigNode;
 
+std::string resolvePath(const ConfigNode& node) {
+  const std::string path = node.str();
+  namespace fs = std::filesystem;
+  try {
+    return core::findData(path);
+  } catch (const core::ConfigError& e) {
+    // then relative to the config file's directory
+    std::error_code ec;
+    const fs::path beside = fs::path(node.file()).parent_path() / path;
+    if (!fs::path(path).is_absolute() && !node.file().empty() && fs::exists(beside, ec)) return beside.lexically_normal().string();
+    node.fail(e.what());
+  }
+}
+
+void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
+  ph.allowOnly({"enabled", "gravity", "scene", "segment_margin", "segment_material", "self_collision", "query_period_steps", "activation_distance",
+                "calibration_clearance", "friction_edges", "recovery_speed", "max_rows"});
+  p.enabled = ph.get("enabled", p.enabled);
+  if (auto g = ph.find("gravity")) p.gravity = g->vec3();
+  if (auto sc = ph.find("scene")) {
+    const std::string path = resolvePath(*sc);
+    try {
+      p.scene = collision::loadScene(path);
+    } catch (const std::exception& e) {
+      sc->fail(std::string("scene: ") + e.what());  // the scene file's own FILE:LINE error follows
+    }
+  } else if (p.enabled) {
+    ph.fail("enabled needs a 'scene' (a scene file, e.g. configs/scenes/floor.yaml)");
+  }
+  p.segment_margin = ph.getIn("segment_margin", p.segment_margin, 0.0, 0.1);
+  p.segment_material = ph.get("segment_material", p.segment_material);
+  if (p.segment_material.empty()) ph["segment_material"].fail("must not be empty");
+  p.self_collision = ph.get("self_collision", p.self_collision);
+  p.query_period_steps = ph.get("query_period_steps", p.query_period_steps);
+  if (p.query_period_steps < 1) ph["query_period_steps"].fail("must be >= 1");
+  p.activation_distance = ph.getIn("activation_distance", p.activation_distance, 0.0, 1.0);
+  p.calibration_clearance = ph.getIn("calibration_clearance", p.calibration_clearance, 0.0, 0.1);
+  p.contacts.friction_edges = ph.get("friction_edges", p.contacts.friction_edges);
+  if (p.contacts.friction_edges < 0 || p.contacts.friction_edges > p.solver.max_edges)
+    ph["friction_edges"].fail("must be in [0, " + std::to_string(p.solver.max_edges) + "]");
+  p.contacts.recovery_speed = ph.getIn("recovery_speed", p.contacts.recovery_speed, 0.0, 100.0);
+  p.solver.max_rows = ph.get("max_rows", p.solver.max_rows);
+  if (p.solver.max_rows < 1 || p.solver.max_rows > 100000) ph["max_rows"].fail("must be in [1, 100000]");
+}
+
 SimServiceConfig parseSimConfig(const ConfigNode& root) {
   root.allowOnly({"name", "publish", "connect", "mode", "step", "world_rate", "publish_on_mocap", "interpolation_delay",
                   "reanchor_threshold", "occlusion", "calibration", "gains", "collision", "mannequins", "stepper",
-                  "target_twist", "joint_limits"});
+                  "target_twist", "joint_limits", "physics", "mocap"});
   SimServiceConfig c;
   c.name = root.get("name", c.name);
   if (auto p = root.find("publish")) c.publish = p->strings();
@@ -73,6 +121,8 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
     c.collision.replay_deadline = col->getIn("replay_deadline", c.collision.replay_deadline, 0.0, 600.0);
     c.collision.margin = col->getIn("margin", c.collision.margin, 0.0, 1.0);
   }
+  if (auto ph = root.find("physics")) parsePhysics(*ph, c.world.physics);
+  if (auto mo = root.find("mocap")) c.mocap = resolvePath(*mo);
   for (const ConfigNode& m : root["mannequins"].items()) {
     m.allowOnly({"name", "config", "root_frame", "control_frames", "controller"});
     MannequinEntry e;

@@ -2,11 +2,58 @@
 
 #include <cmath>
 
+#include "mannequin/lcp/lcp.hpp"
 #include "mannequin/transport/convert.hpp"
 
 namespace mannequin::simservice {
 
 using transport::toMsg;
+
+namespace {
+
+const char* solverName(constraints::SolverUsed s) {
+  switch (s) {
+    case constraints::SolverUsed::kNone: return "none";
+    case constraints::SolverUsed::kLemke: return "lemke";
+    case constraints::SolverUsed::kStructured: return "structured";
+    case constraints::SolverUsed::kPgs: return "pgs";
+    case constraints::SolverUsed::kFailed: return "failed";
+  }
+  return "?";
+}
+
+void toMsg3(const math::Vector3& v, v1::Vec3& out) {
+  out.set_x(v.x());
+  out.set_y(v.y());
+  out.set_z(v.z());
+}
+
+// Wall times are left at 0 in replay mode: the same frames give the same sim.world bytes.
+void toDiagnostics(const sim::StepDiagnostics& d, bool replay, v1::StepDiagnostics& out) {
+  out.set_contacts(d.contacts);
+  out.set_active_contacts(d.active_contacts);
+  out.set_max_penetration_m(d.max_penetration_m);
+  out.set_solver(solverName(d.solver.solver));
+  out.set_lemke_status(lcp::statusName(d.solver.lemke_status));
+  out.set_rows(d.solver.rows);
+  out.set_lcp_size(d.solver.lcp_size);
+  out.set_pivots(d.solver.pivots);
+  out.set_fallback(d.solver.fallback);
+  out.set_dropped_rows(d.solver.dropped);
+  out.set_nan(d.nan);
+  if (replay) return;
+  out.set_collision_s(d.collision_s);
+  out.set_free_motion_s(d.free_motion_s);
+  out.set_constraints_s(d.constraints_s);
+  out.set_integrate_s(d.integrate_s);
+  out.set_produce_s(d.solver.produce_s);
+  out.set_assemble_s(d.solver.assemble_s);
+  out.set_solve_s(d.solver.solve_s);
+}
+
+bool startsWith(const std::string& s, const std::string& prefix) { return s.compare(0, prefix.size(), prefix) == 0; }
+
+}  // namespace
 
 void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool stale, bool replay, v1::WorldState& out) {
   out.Clear();
@@ -17,6 +64,8 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
   out.set_mode(replay ? "replay" : "live");
   out.set_contacts_stale(stale);
   if (contacts != nullptr) out.set_contacts_step(contacts->step());
+  const collision::CollisionWorld* cw = world.physics() ? world.collisionWorld() : nullptr;
+  if (cw != nullptr) toDiagnostics(world.diagnostics(), replay, *out.mutable_diagnostics());
   if (const mocap::Frame* m = world.latestMocap()) {
     v1::FrameRef* r = out.mutable_mocap();
     r->set_sequence(m->sequence);
@@ -51,8 +100,34 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
       c->set_tracked(st.tracked);
       c->set_weight(st.weight);
     }
-    ms->set_balance_distance(NAN);
     ms->set_port_energy(world.stepper(i).portEnergy());
+    if (cw != nullptr) {
+      const sim::MannequinDiagnostics& md = world.mannequinDiagnostics(i);
+      ms->set_balance_distance(md.balance_distance_m);
+      ms->set_contact_count(md.contacts);
+      ms->set_foot_contact(md.foot_contact);
+      ms->set_sole_height(md.sole_height_m);
+      ms->set_worst_joint_limit_excess(md.worst_joint_limit_excess_rad);
+      // the World's contacts touching this mannequin's segments (bodies "<name>/<segment>")
+      const std::string prefix = world.name(i) + "/";
+      for (const sim::ContactReport& k : world.contacts()) {
+        const std::string& a = cw->bodyName(k.body_a);
+        const std::string& b = cw->bodyName(k.body_b);
+        if (!startsWith(a, prefix) && !startsWith(b, prefix)) continue;
+        v1::ContactPoint* p = ms->add_contacts();
+        p->set_body_a(a);
+        p->set_body_b(b);
+        toMsg3(k.normal, *p->mutable_normal());
+        p->set_distance(k.distance);
+        toMsg3(-k.normal_force * k.normal, *p->mutable_force());
+        toMsg3(k.point, *p->mutable_point());
+        p->set_normal_force(k.normal_force);
+        p->set_friction_force(k.friction_force);
+      }
+      continue;  // the physics' contacts, not the collision service's
+    }
+    ms->set_balance_distance(NAN);
+    ms->set_sole_height(NAN);
     if (contacts != nullptr)
       for (const v1::Contact& k : contacts->contacts()) {
         if (k.mannequin_a() != world.name(i) && k.mannequin_b() != world.name(i)) continue;

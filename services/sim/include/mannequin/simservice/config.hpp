@@ -44,11 +44,22 @@ struct SimServiceConfig {
   StepperKind stepper = StepperKind::kController;
   std::vector<MannequinEntry> mannequins;
   CollisionSettings collision;
+  /// Key `mocap`: the mocap config (configs/sim/mocap_*.yaml, its `source` section) mannequin-simulate
+  /// reads the capture from when run offline; found with core::findData, else beside the sim config.
+  /// The service ignores it (it gets mocap.frame). "" when absent.
+  std::string mocap;
 };
 
+/// Key `physics` (sim::PhysicsConfig, docs/cluster.md): {enabled, gravity, scene (a scene file, collision::loadScene),
+/// segment_margin, segment_material, self_collision, query_period_steps, activation_distance, calibration_clearance,
+/// friction_edges, recovery_speed, max_rows}.
 /// \throws core::ConfigError "FILE:LINE: field '...': ...".
 SimServiceConfig parseSimConfig(const core::ConfigNode& root);
 SimServiceConfig loadSimConfig(const std::string& path);
+
+/// A path a config names: found with core::findData, else relative to the config file's directory.
+/// \throws core::ConfigError at the node when neither exists.
+std::string resolvePath(const core::ConfigNode& node);
 
 /// Builds the World's mannequins (loads every mannequin config).
 /// \throws core::ConfigError "FILE:LINE: field 'mannequins[i]': mannequin 'a': ..." naming the entry, then
