@@ -7,6 +7,7 @@
 #include <set>
 #include <stdexcept>
 
+#include "mannequin/constraints/swing_twist.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
@@ -14,15 +15,19 @@
 namespace mannequin::sim {
 
 namespace {
-/// A foot touches the floor when it is pressed (λ > 0) or its margin shell is within this of the floor's (m).
-constexpr double kFootContactTolerance = 0.005;
-
-/// max over limited coordinates of how far q is past a limit (rad, ≥ 0); ball coordinates are the
-/// rotation-vector components the model's boxes bound.
+/// max over limited coordinates of how far q is past a limit (rad, ≥ 0): revolute coordinates against
+/// their bounds, ball joints against their swing ellipse and twist range (Annex D.2, swing_twist.hpp).
 double worstLimitExcess(const skeleton::Model& model, const skeleton::VectorX& q) {
   double worst = 0.0;
   for (const skeleton::Joint& j : model.joints) {
     if (j.type == skeleton::JointType::kFreeFlyer) continue;
+    if (j.type == skeleton::JointType::kBall) {
+      const constraints::BallLimitDistances bd =
+          constraints::ballLimitDistances(j.ball_limit, math::expSO3(q.segment<3>(j.idx_q)));
+      worst = std::max(worst, bd.swing_excess);
+      if (!bd.singular) worst = std::max({worst, -bd.twist_lower, -bd.twist_upper});
+      continue;
+    }
     for (int c = 0; c < j.nq; ++c) {
       const int k = j.idx_q + c;
       const double lo = model.lower_limit(k), hi = model.upper_limit(k);
@@ -70,13 +75,39 @@ struct World::Physics {
   std::vector<std::unique_ptr<constraints::MannequinFrames>> frames;
   std::unique_ptr<constraints::ContactRows> contacts;
   std::vector<std::unique_ptr<constraints::JointLimitRows>> limits;  // per mannequin (joint_limits on)
+  std::vector<std::unique_ptr<constraints::BalanceRows>> balance;    // per mannequin (distance; rows if balance_rows)
+  std::vector<std::vector<math::Vector3>> support;     // per mannequin: foot–floor points (capacity preallocated)
+  std::vector<RigidObject> objects;                    // systems nm + i
+  std::vector<int> object_body;                        // per object: collision body id
+  std::unique_ptr<HingeLimitRows> hinges;
+  std::unique_ptr<GraspRows> grasps;
+  struct GraspRecord {
+    int object = -1, mannequin = -1;                   // −1: free slot
+  };
+  std::vector<GraspRecord> grasp_records;              // per GraspRows handle
   std::unique_ptr<constraints::ConstraintSolver> solver;
   collision::ContactSet set;
   int floor_body = -1;                                 // "scene/floor", −1 if none
   std::vector<int> body_mannequin;                     // per body: mannequin index or −1
+  std::vector<int> body_object;                        // per body: object index or −1
   std::vector<char> body_is_foot;                      // per body: a foot segment ("foot*", "toes*")
   std::vector<char> stepping;                          // per mannequin: stage 1 succeeded this step
   explicit Physics(const collision::WorldOptions& o) : cw(o) {}
+  /// Whether mannequin m holds object o (contacts between them are ignored).
+  bool holds(int m, int o) const {
+    for (const GraspRecord& g : grasp_records)
+      if (g.mannequin == m && g.object == o) return true;
+    return false;
+  }
+};
+
+/// A mocap source: its frames, and the anchor of its capture clock to the World clock.
+struct World::Source {
+  std::string name;
+  MocapBuffer buffer{2.0};
+  bool anchored = false;
+  std::int64_t anchor_capture_ns = 0;
+  std::uint64_t anchor_step = 0;
 };
 
 struct World::Mannequin {
@@ -84,6 +115,7 @@ struct World::Mannequin {
   skeleton::Model model;
   std::vector<ControlFrameSpec> specs;
   int root_frame = -1;
+  int source = 0;  // index in World::sources_
   std::vector<int> frame_indices;
   std::unique_ptr<Stepper> stepper;
   std::vector<DrivenFrame> frames;
@@ -94,12 +126,19 @@ struct World::Mannequin {
   skeleton::VectorX q_standing;
 };
 
-World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : config_(config), buffer_(2.0) {
+World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : config_(config) {
   if (!(config_.step > 0) || !std::isfinite(config_.step)) throw std::invalid_argument("sim: step must be > 0");
+  sources_.push_back(std::make_unique<Source>());  // the default source ""
   std::set<std::string> names;
   for (MannequinSetup& s : setups) {
     if (!names.insert(s.name).second) throw std::invalid_argument("sim: two mannequins named '" + s.name + "'");
     auto m = std::make_unique<Mannequin>();
+    if (findSource(s.mocap_source) == nullptr) {
+      sources_.push_back(std::make_unique<Source>());
+      sources_.back()->name = s.mocap_source;
+    }
+    for (std::size_t i = 0; i < sources_.size(); ++i)
+      if (sources_[i]->name == s.mocap_source) m->source = static_cast<int>(i);
     m->name = s.name;
     m->model = std::move(s.model);
     m->specs = s.frames;
@@ -173,6 +212,18 @@ void World::buildPhysics() {
     P.frames.push_back(std::make_unique<constraints::MannequinFrames>(mp->model, cs->controller().data()));
     systems.push_back(P.systems.back().get());
   }
+  // the scene's movable bodies with a mass: rigid objects, systems after the mannequins
+  if (!(pc.object_time_constant > 0) || !std::isfinite(pc.object_time_constant))
+    throw std::invalid_argument("sim: physics.object_time_constant must be finite and > 0");
+  std::vector<int> object_spec;
+  P.objects = makeObjects(scene, &object_spec, pc.object_time_constant);
+  for (std::size_t i = 0; i < P.objects.size(); ++i) {
+    const int b = P.cw.findBody("scene/" + scene.bodies[static_cast<std::size_t>(object_spec[i])].name);
+    if (b < 0) throw std::logic_error("sim: object '" + P.objects[i].name() + "' has no collision body");
+    P.object_body.push_back(b);
+    P.cw.setBodyPose(b, P.objects[i].pose());
+    systems.push_back(&P.objects[i]);
+  }
   // materials: the scene's, then the segments'; μ from the scene's table (default_mu elsewhere)
   std::vector<std::string> materials{scene.default_material};
   const auto material = [&](const std::string& name) {
@@ -184,6 +235,7 @@ void World::buildPhysics() {
   const int n = P.cw.bodyCount();
   std::vector<constraints::BodyBinding> bindings(static_cast<std::size_t>(n));
   P.body_mannequin.assign(static_cast<std::size_t>(n), -1);
+  P.body_object.assign(static_cast<std::size_t>(n), -1);
   P.body_is_foot.assign(static_cast<std::size_t>(n), 0);
   for (int b = 0; b < n; ++b) {
     constraints::BodyBinding& bb = bindings[static_cast<std::size_t>(b)];
@@ -193,6 +245,15 @@ void World::buildPhysics() {
     if (bname == "scene/floor") P.floor_body = b;
     for (const collision::BodySpec& bs : scene.bodies)
       if ("scene/" + bs.name == bname) bb.material = material(bs.material);
+  }
+  const int nm = static_cast<int>(mannequins_.size());
+  for (std::size_t i = 0; i < P.objects.size(); ++i) {
+    const int b = P.object_body[i];
+    constraints::BodyBinding& bb = bindings[static_cast<std::size_t>(b)];
+    bb.system = nm + static_cast<int>(i);
+    bb.frames = &P.objects[i];
+    bb.local = 0;
+    P.body_object[static_cast<std::size_t>(b)] = static_cast<int>(i);
   }
   const int seg_material = material(pc.segment_material);
   for (std::size_t m = 0; m < mannequins_.size(); ++m) {
@@ -211,8 +272,8 @@ void World::buildPhysics() {
     }
   }
   constraints::ContactOptions co = pc.contacts;
-  const int nm = static_cast<int>(materials.size());
-  co.mu = Eigen::MatrixXd::Constant(nm, nm, scene.default_mu);
+  const int n_materials = static_cast<int>(materials.size());
+  co.mu = Eigen::MatrixXd::Constant(n_materials, n_materials, scene.default_mu);
   for (const collision::FrictionPair& fp : scene.friction) {
     const int a = material(fp.a), b = material(fp.b);
     if (a >= co.mu.rows() || b >= co.mu.rows()) continue;  // a material no body uses
@@ -228,6 +289,43 @@ void World::buildPhysics() {
       P.solver->addProducer(P.limits.back().get());
     }
   P.solver->addProducer(P.contacts.get());
+  // hinge limits of the hinged objects, grasps of any object by any mannequin body
+  std::vector<HingeLimitRows::Entry> hinged;
+  std::vector<const RigidObject*> all_objects;
+  std::vector<int> object_systems;
+  int max_nv = 6;
+  for (std::size_t i = 0; i < P.objects.size(); ++i) {
+    if (P.objects[i].hinged()) hinged.push_back({&P.objects[i], nm + static_cast<int>(i)});
+    all_objects.push_back(&P.objects[i]);
+    object_systems.push_back(nm + static_cast<int>(i));
+  }
+  for (const auto& mp : mannequins_) max_nv = std::max(max_nv, mp->model.nv);
+  if (!hinged.empty()) {
+    P.hinges = std::make_unique<HingeLimitRows>(std::move(hinged));
+    P.solver->addProducer(P.hinges.get());
+  }
+  if (!P.objects.empty()) {
+    P.grasps = std::make_unique<GraspRows>(std::move(all_objects), std::move(object_systems), max_nv);
+    P.solver->addProducer(P.grasps.get());
+    P.grasp_records.assign(8, {});  // GraspRows' default max_grasps
+  }
+  // balance: the support region of each mannequin's feet, its CoM distance, and (balance_rows) its row
+  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+    auto& cs = static_cast<ControllerStepper&>(*mannequins_[m]->stepper);
+    P.balance.push_back(std::make_unique<constraints::BalanceRows>(static_cast<int>(m), mannequins_[m]->model,
+                                                                   cs.controller().data(), pc.balance));
+    P.support.emplace_back();
+    P.support.back().reserve(static_cast<std::size_t>(pc.balance.max_points));
+    if (pc.balance_rows) P.solver->addProducer(P.balance.back().get());
+  }
+  // the floor plane of the support regions: the floor body's plane (z = 0, +z without one)
+  for (const collision::BodySpec& bs : scene.bodies)
+    if (bs.name == "floor")
+      for (const collision::PlacedShape& ps : bs.shapes)
+        if (ps.shape.type == collision::ShapeType::kPlane) {
+          const math::SE3 T = bs.pose * ps.pose;
+          for (auto& b : P.balance) b->setFloor(T.act(ps.shape.normal * ps.shape.offset), T.R * ps.shape.normal);
+        }
   P.stepping.assign(mannequins_.size(), 0);
   P.set.contacts.reserve(static_cast<std::size_t>(pc.solver.max_rows));
   contacts_.reserve(static_cast<std::size_t>(pc.solver.max_rows));
@@ -241,6 +339,82 @@ const MannequinDiagnostics& World::mannequinDiagnostics(int m) const {
 
 World::~World() = default;
 
+World::Source* World::findSource(const std::string& name) {
+  for (auto& src : sources_)
+    if (src->name == name) return src.get();
+  return nullptr;
+}
+const World::Source* World::findSource(const std::string& name) const {
+  for (const auto& src : sources_)
+    if (src->name == name) return src.get();
+  return nullptr;
+}
+std::vector<std::string> World::mocapSources() const {
+  std::vector<std::string> out;
+  for (const auto& src : sources_) out.push_back(src->name);
+  return out;
+}
+const mocap::Frame* World::latestMocap(const std::string& source) const {
+  const Source* src = findSource(source);
+  return src != nullptr ? src->buffer.newest() : nullptr;
+}
+bool World::anchored(const std::string& source) const {
+  const Source* src = findSource(source);
+  return src != nullptr && src->anchored;
+}
+
+int World::numObjects() const { return physics_ ? static_cast<int>(physics_->objects.size()) : 0; }
+const RigidObject& World::object(int i) const {
+  if (i < 0 || i >= numObjects()) throw std::out_of_range("sim: no object " + std::to_string(i));
+  return physics_->objects[static_cast<std::size_t>(i)];
+}
+RigidObject& World::object(int i) {
+  if (i < 0 || i >= numObjects()) throw std::out_of_range("sim: no object " + std::to_string(i));
+  return physics_->objects[static_cast<std::size_t>(i)];
+}
+int World::findObject(const std::string& name) const {
+  for (int i = 0; i < numObjects(); ++i)
+    if (physics_->objects[static_cast<std::size_t>(i)].name() == name) return i;
+  return -1;
+}
+int World::objectBody(int i) const {
+  (void)object(i);
+  return physics_->object_body[static_cast<std::size_t>(i)];
+}
+
+int World::grasp(int m, const std::string& frame, const std::string& object_name) {
+  if (!physics_) throw std::invalid_argument("sim: grasp needs physics (physics.enabled)");
+  if (m < 0 || m >= numMannequins()) throw std::invalid_argument("sim: grasp: no mannequin " + std::to_string(m));
+  const skeleton::Model& model = mannequins_[static_cast<std::size_t>(m)]->model;
+  const int f = model.findFrame(frame);
+  if (f < 0) throw std::invalid_argument("sim: grasp: mannequin '" + name(m) + "' has no frame '" + frame + "'");
+  const int o = findObject(object_name);
+  if (o < 0) throw std::invalid_argument("sim: grasp: no object '" + object_name + "' (movable scene bodies with a mass)");
+  Physics& P = *physics_;
+  GraspRows::Hand hand;
+  hand.system = m;
+  hand.frames = P.frames[static_cast<std::size_t>(m)].get();
+  hand.local = model.frames[static_cast<std::size_t>(f)].joint;
+  const int handle = P.grasps->grasp(hand, o);
+  if (handle < 0) return -1;
+  if (static_cast<std::size_t>(handle) >= P.grasp_records.size()) P.grasp_records.resize(static_cast<std::size_t>(handle) + 1);
+  P.grasp_records[static_cast<std::size_t>(handle)] = {o, m};
+  return handle;
+}
+
+bool World::release(int handle) {
+  if (!physics_ || !physics_->grasps || !physics_->grasps->release(handle)) return false;
+  physics_->grasp_records[static_cast<std::size_t>(handle)] = {};
+  return true;
+}
+
+math::Vector3 World::graspForce(int handle) const {
+  if (!physics_ || !physics_->grasps || handle < 0 || static_cast<std::size_t>(handle) >= physics_->grasp_records.size() ||
+      physics_->grasp_records[static_cast<std::size_t>(handle)].object < 0)
+    return math::Vector3::Zero();
+  return physics_->grasps->force(handle);
+}
+
 const std::string& World::name(int m) const { return mannequins_.at(m)->name; }
 const skeleton::Model& World::model(int m) const { return mannequins_.at(m)->model; }
 const skeleton::Data& World::data(int m) const { return mannequins_.at(m)->stepper->data(); }
@@ -250,15 +424,20 @@ bool World::calibrated(int m) const { return mannequins_.at(m)->calibrated; }
 const Stepper& World::stepper(int m) const { return *mannequins_.at(m)->stepper; }
 const std::vector<DrivenFrame>& World::controlFrames(int m) const { return mannequins_.at(m)->frames; }
 
-void World::anchor(std::int64_t capture_ns) {
-  anchored_ = true;
-  anchor_capture_ns_ = capture_ns;
-  anchor_step_ = steps_;
+void World::anchor(std::int64_t capture_ns, const std::string& source) {
+  Source* src = findSource(source);
+  if (src == nullptr) return;
+  src->anchored = true;
+  src->anchor_capture_ns = capture_ns;
+  src->anchor_step = steps_;
 }
 
-std::int64_t World::captureTimeNs() const {
+std::int64_t World::captureTimeNs(const std::string& source) const {
+  const Source* src = findSource(source);
+  if (src == nullptr) return 0;
   const double dt_ns = config_.step * 1e9;
-  return anchor_capture_ns_ + static_cast<std::int64_t>(std::llround(static_cast<double>(steps_ - anchor_step_) * dt_ns)) -
+  return src->anchor_capture_ns +
+         static_cast<std::int64_t>(std::llround(static_cast<double>(steps_ - src->anchor_step) * dt_ns)) -
          static_cast<std::int64_t>(std::llround(config_.interpolation_delay * 1e9));
 }
 
@@ -347,10 +526,12 @@ double World::soleGap(Mannequin& m, const skeleton::VectorX& q) {
   return gap;
 }
 
-void World::addMocap(const mocap::Frame& frame) {
-  if (!buffer_.add(frame)) return;
+bool World::addMocap(const mocap::Frame& frame, const std::string& source) {
+  Source* src = findSource(source);
+  if (src == nullptr || !src->buffer.add(frame)) return false;
   for (auto& m : mannequins_)
-    if (!m->calibrated) calibrate(*m, frame);
+    if (!m->calibrated && sources_[static_cast<std::size_t>(m->source)].get() == src) calibrate(*m, frame);
+  return true;
 }
 
 math::Vector6 World::targetTwist(Mannequin& m, std::size_t i, double dt) const {
@@ -370,11 +551,13 @@ math::Vector6 World::targetTwist(Mannequin& m, std::size_t i, double dt) const {
   return V;
 }
 
-void World::driveTargets(Mannequin& m, std::int64_t t, double dt) {
-  if (m.calibrated && anchored_) {
+void World::driveTargets(Mannequin& m, double dt) {
+  const Source& src = *sources_[static_cast<std::size_t>(m.source)];
+  if (m.calibrated && src.anchored) {
+    const std::int64_t t = captureTimeNs(src.name);
     for (std::size_t i = 0; i < m.frames.size(); ++i) {
       DrivenFrame& st = m.frames[i];
-      const BodySample s = buffer_.sample(st.body, t);
+      const BodySample s = src.buffer.sample(st.body, t);
       double goal = 1.0;
       if (s.tracked) {
         st.target = s.pose * st.offset;
@@ -419,6 +602,7 @@ bool World::physicsStep() {
       ++failed_steps_;
     }
   }
+  for (RigidObject& o : P.objects) o.computeFreeMotion(config_.physics.gravity, dt);
   const auto t1 = Clock::now();
   // contacts at q_k: a query every query_period_steps; in between, the last query's witness points are
   // re-evaluated at q_k by the contact rows
@@ -428,8 +612,24 @@ bool World::physicsStep() {
       P.cw.updateMannequin(P.cw_mannequin[m], cs.controller().data());
     }
     P.cw.query(steps_, P.set);
+    // a held object and the mannequin holding it: the grasp rows couple them, no contact rows
+    bool any_grasp = false;
+    for (const Physics::GraspRecord& g : P.grasp_records) any_grasp = any_grasp || g.object >= 0;
+    if (any_grasp) {
+      auto& v = P.set.contacts;
+      v.erase(std::remove_if(v.begin(), v.end(),
+                             [&](const collision::Contact& c) {
+                               const int oa = P.body_object[static_cast<std::size_t>(c.body_a)];
+                               const int ob = P.body_object[static_cast<std::size_t>(c.body_b)];
+                               const int ma = P.body_mannequin[static_cast<std::size_t>(c.body_a)];
+                               const int mb = P.body_mannequin[static_cast<std::size_t>(c.body_b)];
+                               return (oa >= 0 && mb >= 0 && P.holds(mb, oa)) || (ob >= 0 && ma >= 0 && P.holds(ma, ob));
+                             }),
+              v.end());
+    }
     P.contacts->setContacts(P.set);
   }
+  updateSupport();
   const auto t2 = Clock::now();
   // stage 2: every row in one LCP (systems that failed stage 1 get no force: their q̇ is zero)
   diagnostics_.solver = P.solver->solve(dt);
@@ -441,6 +641,10 @@ bool World::physicsStep() {
       ok = false;
       ++failed_steps_;
     }
+  }
+  for (std::size_t i = 0; i < P.objects.size(); ++i) {
+    P.objects[i].integrate(dt);
+    P.cw.setBodyPose(P.object_body[i], P.objects[i].pose());
   }
   const auto t4 = Clock::now();
   diagnostics_.free_motion_s = seconds(t0, t1);
@@ -485,7 +689,7 @@ bool World::physicsStep() {
         const double gap = st.distance + P.cw.margin(c.body_a) + P.cw.margin(c.body_b);
         md.sole_height_m = std::min(md.sole_height_m, gap);
         // touching: pressed, or its margin shell within 1 mm of the floor's
-        if (st.normal_force > 0 || st.distance <= kFootContactTolerance) md.foot_contact = true;
+        if (st.normal_force > 0 || st.distance <= config_.physics.foot_contact_tolerance) md.foot_contact = true;
       }
     }
   }
@@ -495,15 +699,42 @@ bool World::physicsStep() {
     if (!std::isfinite(md.sole_height_m)) md.sole_height_m = config_.physics.activation_distance;
     auto& cs = static_cast<ControllerStepper&>(*mannequins_[m]->stepper);
     md.worst_joint_limit_excess_rad = worstLimitExcess(mannequins_[m]->model, cs.q());
+    // balance at q_k (the support and CoM the step's row saw)
+    const constraints::BalanceRows::State& bs = P.balance[m]->state();
+    md.balance_distance_m = bs.distance.polygon_m;
+    md.com = bs.com;
+    md.support_points = static_cast<int>(P.support[m].size());
   }
   return ok;
 }
 
+void World::updateSupport() {
+  // each mannequin's support: the floor-side witness points of its feet's floor contacts within the
+  // tolerance (the contact set of the last query, at the segment poses of that query)
+  Physics& P = *physics_;
+  for (auto& sp : P.support) sp.clear();
+  if (P.floor_body >= 0)
+    for (const collision::Contact& c : P.set.contacts) {
+      if (c.distance > config_.physics.foot_contact_tolerance) continue;
+      const bool a_floor = c.body_a == P.floor_body, b_floor = c.body_b == P.floor_body;
+      if (a_floor == b_floor) continue;
+      const int foot = a_floor ? c.body_b : c.body_a;
+      if (!P.body_is_foot[static_cast<std::size_t>(foot)]) continue;
+      const int m = P.body_mannequin[static_cast<std::size_t>(foot)];
+      std::vector<math::Vector3>& sp = P.support[static_cast<std::size_t>(m)];
+      if (sp.size() == sp.capacity()) continue;  // beyond max_points: the hull of the first ones
+      sp.push_back(P.cw.bodyPose(foot).act(a_floor ? c.point_b : c.point_a));
+    }
+  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+    P.balance[m]->setSupport(P.support[m]);
+    if (!config_.physics.balance_rows) P.balance[m]->evaluate();  // the distance without the row
+  }
+}
+
 bool World::step() {
-  const std::int64_t t = captureTimeNs();
   const double dt = config_.step;
   bool ok = true;
-  for (auto& mp : mannequins_) driveTargets(*mp, t, dt);
+  for (auto& mp : mannequins_) driveTargets(*mp, dt);
   if (physics_) {
     ok = physicsStep();
     diagnostics_.nan = !ok;

@@ -33,10 +33,12 @@
 
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/collision/world.hpp"
+#include "mannequin/constraints/balance.hpp"
 #include "mannequin/constraints/contacts.hpp"
 #include "mannequin/constraints/joint_limits.hpp"
 #include "mannequin/constraints/solver.hpp"
 #include "mannequin/sim/mocap_buffer.hpp"
+#include "mannequin/sim/rigid_object.hpp"
 #include "mannequin/control/config.hpp"
 #include "mannequin/sim/stepper.hpp"
 #include "mannequin/sim/tracker.hpp"
@@ -55,6 +57,10 @@ struct MannequinSetup {
   skeleton::Model model;        ///< built from configs/mannequins/*.yaml by the caller
   std::vector<ControlFrameSpec> frames;
   std::string root_frame = "pelvis";  ///< frame whose body places the mannequin at calibration
+  /// The mocap source whose bodies drive this mannequin (World::addMocap(frame, source)); "" is the
+  /// default source. Two actors captured by two systems: two mannequins with two sources, each with
+  /// its own buffer and clock anchor.
+  std::string mocap_source;
   /// The controller's config (configs/control/*.yaml): steps the mannequin with a ControllerStepper.
   /// Empty: the KinematicTracker with SimConfig::gains.
   std::optional<control::ControllerConfig> controller;
@@ -80,6 +86,16 @@ struct PhysicsConfig {
   /// floor are lifted by the sole's calibration depth plus this clearance (m).
   double calibration_clearance = 0.002;
   constraints::ContactOptions contacts;  ///< friction edges, recovery speed (μ from the scene)
+  /// Coplanar balance (thesis 3.3.2.1): the support region of each mannequin is rebuilt every step from
+  /// its feet's floor contacts (within `foot_contact_tolerance`), and the signed distance of its CoM
+  /// projection is in MannequinDiagnostics::balance_distance_m. With `balance_rows` the distance is
+  /// also a unilateral row of the step's LCP (the CoM is kept over the support); off by default: a
+  /// captured actor's hops and steps leave the support on purpose.
+  bool balance_rows = false;
+  constraints::BalanceOptions balance;
+  double foot_contact_tolerance = 0.005;  ///< m between the margin shells: a foot touching the floor
+  /// τ of the scene's objects without a `time_constant` (s; sim::RigidObject).
+  double object_time_constant = 0.05;
   constraints::SolverOptions solver;
 };
 
@@ -118,6 +134,8 @@ struct MannequinDiagnostics {
   double sole_height_m = 0.0;       ///< signed height of the lowest sole point above the floor (real geometry)
   double balance_distance_m = std::numeric_limits<double>::quiet_NaN();  ///< signed (3.22); NaN: no support
   double worst_joint_limit_excess_rad = 0.0;  ///< max over coordinates of how far past a limit (≥ 0)
+  math::Vector3 com = math::Vector3::Zero();  ///< centre of mass (world, m) at q_k
+  int support_points = 0;           ///< foot–floor contact points of the support region
 };
 
 /// What the last step did (thesis Alg. 4 stages), for callers and sim.world.
@@ -153,13 +171,16 @@ class World {
   World(std::vector<MannequinSetup> mannequins, const SimConfig& config);
   ~World();
 
-  /// Adds a mocap frame (ignored if not newer than the last). Calibrates mannequins when possible.
-  void addMocap(const mocap::Frame& frame);
-  /// Ties the World clock to the capture clock: now, capture time is `capture_ns`.
-  void anchor(std::int64_t capture_ns);
-  bool anchored() const { return anchored_; }
-  /// Capture time the next step samples targets at (ns).
-  std::int64_t captureTimeNs() const;
+  /// Adds a mocap frame of `source` (ignored if not newer than that source's last). Calibrates the
+  /// mannequins it drives when possible. Returns false for a frame ignored or a source no mannequin uses.
+  bool addMocap(const mocap::Frame& frame, const std::string& source = "");
+  /// Ties the World clock to a source's capture clock: now, that source's capture time is `capture_ns`.
+  void anchor(std::int64_t capture_ns, const std::string& source = "");
+  bool anchored(const std::string& source = "") const;
+  /// Capture time (ns) of `source` the next step samples targets at.
+  std::int64_t captureTimeNs(const std::string& source = "") const;
+  /// The mocap sources the mannequins use ("" first).
+  std::vector<std::string> mocapSources() const;
   /// One fixed step. Returns false if a mannequin's step failed numerically (its state is kept).
   bool step();
 
@@ -176,8 +197,8 @@ class World {
   /// The mannequin's stepper (kind(), and for a ControllerStepper its controller).
   const Stepper& stepper(int m) const;
   const std::vector<DrivenFrame>& controlFrames(int m) const;
-  /// The newest mocap frame added (nullptr before any).
-  const mocap::Frame* latestMocap() const { return buffer_.newest(); }
+  /// The newest mocap frame added to `source` (nullptr before any, or an unknown source).
+  const mocap::Frame* latestMocap(const std::string& source = "") const;
   std::uint64_t failedSteps() const { return failed_steps_; }
 
   //---- physics (PhysicsConfig::enabled) ----
@@ -191,23 +212,47 @@ class World {
   /// The constraint solver (nullptr when physics is off).
   const constraints::ConstraintSolver* constraintSolver() const;
 
+  //---- objects of the physics scene (movable bodies with a mass) and grasps ----
+  int numObjects() const;
+  /// \throws std::out_of_range
+  const RigidObject& object(int i) const;
+  /// For pushes (RigidObject::addForce) and resets between steps.
+  RigidObject& object(int i);
+  /// Index of the object named `name`, −1 if none.
+  int findObject(const std::string& name) const;
+  /// Collision body id of object i.
+  int objectBody(int i) const;
+  /// Grasps object `object` with the body carrying `frame` of mannequin `m` (e.g. "palm_l", "hand_r") at
+  /// their current relative pose (thesis 4.3.1: bilateral rows until release). Contacts between the
+  /// object and that mannequin's segments are ignored while held. Returns a handle ≥ 0, or −1 when the
+  /// object is already held by this frame's body or every grasp slot is used.
+  /// \throws std::invalid_argument naming an unknown mannequin, frame or object, or physics off.
+  int grasp(int m, const std::string& frame, const std::string& object);
+  /// Releases a grasp; false for an unknown handle.
+  bool release(int handle);
+  /// Force (N, world) the grasp `handle` applied on its object at the last step (the hand gets the
+  /// opposite); zero for an unknown handle.
+  math::Vector3 graspForce(int handle) const;
+
  private:
   struct Mannequin;
   struct Physics;
+  struct Source;
+  Source* findSource(const std::string& name);
+  const Source* findSource(const std::string& name) const;
   void calibrate(Mannequin& m, const mocap::Frame& frame);
+  void updateSupport();
+  void fillDiagnostics();
   void buildPhysics();
   /// Distance after margins of mannequin m's lowest sole to the floor at q (m; +inf: no floor).
   double soleGap(Mannequin& m, const skeleton::VectorX& q);
-  void driveTargets(Mannequin& m, std::int64_t capture_ns, double dt);
+  void driveTargets(Mannequin& m, double dt);
   bool physicsStep();
   math::Vector6 targetTwist(Mannequin& m, std::size_t i, double dt) const;
   std::vector<std::unique_ptr<Mannequin>> mannequins_;
   SimConfig config_;
-  MocapBuffer buffer_;
+  std::vector<std::unique_ptr<Source>> sources_;  // "" first
   std::uint64_t steps_ = 0, failed_steps_ = 0;
-  bool anchored_ = false;
-  std::int64_t anchor_capture_ns_ = 0;
-  std::uint64_t anchor_step_ = 0;
   std::unique_ptr<Physics> physics_;
   StepDiagnostics diagnostics_;
   std::vector<MannequinDiagnostics> mannequin_diagnostics_;
