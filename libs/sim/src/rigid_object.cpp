@@ -209,7 +209,11 @@ GraspRows::GraspRows(std::vector<const RigidObject*> objects, std::vector<int> o
 
 int GraspRows::grasp(const Hand& hand, int object) {
   if (object < 0 || object >= static_cast<int>(objects_.size()) || !hand.frames || hand.system < 0) return -1;
-  if (hand.system == systems_[object] || held(object)) return -1;
+  if (hand.system == systems_[object]) return -1;
+  for (const Grasp& gr : grasps_)  // this hand holds it already (several hands may hold one object)
+    if (gr.active && gr.object == object && gr.hand.system == hand.system && gr.hand.frames == hand.frames &&
+        gr.hand.local == hand.local)
+      return -1;
   for (std::size_t g = 0; g < grasps_.size(); ++g) {
     Grasp& gr = grasps_[g];
     if (gr.active) continue;

@@ -160,9 +160,10 @@ class GraspRows final : public constraints::RowProducer {
             int max_grasps = 8, double recovery_speed = 0.5);
   const char* name() const override { return "grasps"; }
 
-  /// Grasps object `object` with `hand` at their current relative pose. Returns a handle ≥ 0, or −1
-  /// (bad object index, hand without frames or system, object already held, no free slot). No
-  /// allocation.
+  /// Grasps object `object` with `hand` at their current relative pose. Several hands may hold one
+  /// object (two hands, two mannequins carrying a box: a closed chain whose rows stay independent as
+  /// each hand brings its own arm's joints). Returns a handle ≥ 0, or −1 (bad object index, hand
+  /// without frames or system, this hand already holds it, no free slot). No allocation.
   int grasp(const Hand& hand, int object);
   /// Releases a grasp; false for an unknown handle.
   bool release(int handle);

@@ -1,0 +1,353 @@
+// sim::World with physics, objects and several mannequins (thesis 3.2, 3.3.2.1, 4.3.1, Fig. 4.17):
+// the balance distance of a standing mannequin, the table scene's objects resting in the World, a hand
+// driven 10 cm into a table stopping on it, two actors (two mocap sources) lifting a box by its handles
+// and carrying it 1 m.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+
+#include "mannequin/collision/scene.hpp"
+#include "mannequin/control/config.hpp"
+#include "mannequin/math/so3.hpp"
+#include "mannequin/sim/world.hpp"
+#include "mannequin/skeleton/anthropometry.hpp"
+
+using namespace mannequin;
+using namespace mannequin::sim;
+
+namespace {
+const skeleton::Model& male50() {
+  static const skeleton::Model m = skeleton::buildMannequin(skeleton::loadMannequinSpec("configs/mannequins/male_50th.yaml"));
+  return m;
+}
+
+const char* const kBodies[] = {"pelvis", "head", "hand_l", "hand_r", "foot_l", "foot_r"};
+
+MannequinSetup actorSetup(const std::string& name, const std::string& source) {
+  MannequinSetup m;
+  m.name = name;
+  m.model = male50();
+  m.mocap_source = source;
+  for (const char* b : kBodies) m.frames.push_back({b, b});
+  m.controller = control::loadControllerConfig("configs/control/mocap.yaml");
+  return m;
+}
+
+/// The frames of the standing mannequin placed by `base` (world), as a mocap frame; `moved` replaces
+/// some bodies' positions (world), keeping their standing orientation.
+mocap::Frame actorFrame(std::int64_t stamp_ns, const math::SE3& base, const std::map<std::string, math::Vector3>& moved = {}) {
+  static const skeleton::Data standing = [] {
+    skeleton::Data d(male50());
+    skeleton::forwardKinematics(male50(), d, skeleton::standingConfiguration(male50()));
+    return d;
+  }();
+  mocap::Frame f;
+  f.stamp_ns = stamp_ns;
+  f.sequence = static_cast<std::uint64_t>(stamp_ns / 1000000 + 1);
+  for (const char* b : kBodies) {
+    math::SE3 T = base * standing.oMf[static_cast<std::size_t>(male50().frameIndex(b))];
+    if (auto it = moved.find(b); it != moved.end()) T.p = it->second;
+    f.bodies.push_back({b, T, true});
+  }
+  return f;
+}
+
+/// Standing frame `body` placed by `base` (world).
+math::SE3 standingFrame(const math::SE3& base, const std::string& body) {
+  skeleton::Data d(male50());
+  skeleton::forwardKinematics(male50(), d, skeleton::standingConfiguration(male50()));
+  return base * d.oMf[static_cast<std::size_t>(male50().frameIndex(body))];
+}
+
+math::SE3 placed(double x, double y, double yaw) {
+  return math::SE3(math::expSO3(math::Vector3(0, 0, yaw)), math::Vector3(x, y, 0));
+}
+
+double smooth(double s) {
+  s = std::clamp(s, 0.0, 1.0);
+  return s * s * (3 - 2 * s);
+}
+
+SimConfig physicsConfig(const std::string& scene_yaml) {
+  SimConfig c;
+  c.physics.enabled = true;
+  c.physics.scene = collision::parseScene(scene_yaml, "test-scene.yaml");
+  return c;
+}
+
+/// Steps the World at 1 kHz for `seconds`, feeding each source a frame every 10 ms from `frames(t)`.
+/// `each` runs after every step; a false return stops early (returns false).
+bool run(World& w, double t0, double seconds, const std::function<void(double)>& feed,
+         const std::function<bool(double)>& each = nullptr) {
+  const long steps = std::lround(seconds / w.config().step);
+  for (long k = 0; k < steps; ++k) {
+    const double t = t0 + static_cast<double>(k) * w.config().step;
+    if (k % 10 == 0) feed(t);
+    if (!w.step()) return false;
+    if (each && !each(t)) return false;
+  }
+  return true;
+}
+
+std::int64_t ns(double t) { return static_cast<std::int64_t>(std::llround(t * 1e9)); }
+
+double normalForceOn(const World& w, int body) {
+  double f = 0;
+  for (const ContactReport& c : w.contacts())
+    if (c.body_a == body || c.body_b == body) f += c.normal_force;
+  return f;
+}
+}  // namespace
+
+// Coplanar balance (3.22): the standing mannequin's CoM projects inside the support polygon of its
+// feet's floor contacts; its signed distance is published, positive, and smaller than the half-width
+// of the stance (the feet are ~0.2 m apart, so the CoM is at most ~0.15 m inside any edge).
+TEST(WorldPhysics, StandingBalanceDistanceIsPositiveInsideTheFeet) {
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("operator", ""));
+  World w(std::move(setups), physicsConfig("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"));
+  const math::SE3 base = placed(0, 0, 0);
+  w.addMocap(actorFrame(0, base));
+  w.anchor(0);
+  ASSERT_TRUE(w.calibrated(0));
+  ASSERT_TRUE(run(w, 0, 1.0, [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base)); }));
+  const MannequinDiagnostics& md = w.mannequinDiagnostics(0);
+  std::printf("standing: %d support points, balance distance %.4f m, CoM (%.3f, %.3f, %.3f)\n", md.support_points,
+              md.balance_distance_m, md.com.x(), md.com.y(), md.com.z());
+  EXPECT_GE(md.support_points, 3);
+  ASSERT_TRUE(std::isfinite(md.balance_distance_m));
+  EXPECT_GT(md.balance_distance_m, 0.02);
+  EXPECT_LT(md.balance_distance_m, 0.2);
+  EXPECT_GT(md.com.z(), 0.8);  // a standing adult's CoM: ~55% of 1.75 m
+  EXPECT_LT(md.com.z(), 1.1);
+}
+
+// The shipped table scene in a World with a standing mannequin: its ball (0.45 kg) and tray (0.6 kg)
+// are systems of the step's LCP and rest on the table, the contact forces under each equal to its
+// weight within 1% (Fig. 3.6), and they appear among the World's objects.
+TEST(WorldPhysics, TableSceneObjectsRestInTheWorld) {
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("operator", ""));
+  SimConfig cfg;
+  cfg.physics.enabled = true;
+  cfg.physics.scene = collision::loadScene("configs/scenes/table.yaml");
+  World w(std::move(setups), cfg);
+  ASSERT_EQ(w.numObjects(), 2);  // the tool has no mass: kinematic, not an object
+  const int ball = w.findObject("ball"), tray = w.findObject("tray");
+  ASSERT_GE(ball, 0);
+  ASSERT_GE(tray, 0);
+  EXPECT_EQ(w.findObject("tool"), -1);
+  const math::SE3 base = placed(-0.2, 0, 0);
+  w.addMocap(actorFrame(0, base));
+  w.anchor(0);
+  double ball_lowest = 1e9;
+  ASSERT_TRUE(run(w, 0, 1.5, [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base)); },
+                  [&](double) {
+                    ball_lowest = std::min(ball_lowest, w.object(ball).pose().p.z());
+                    return true;
+                  }));
+  const double g = 9.81;
+  const double f_ball = normalForceOn(w, w.objectBody(ball)), f_tray = normalForceOn(w, w.objectBody(tray));
+  std::printf("table scene: ball rests at z = %.5f m (lowest %.5f) on %.4f N (m g = %.4f N), tray on %.4f N (%.4f N)\n",
+              w.object(ball).pose().p.z(), ball_lowest, f_ball, 0.45 * g, f_tray, 0.6 * g);
+  EXPECT_NEAR(f_ball, 0.45 * g, 0.01 * 0.45 * g);
+  EXPECT_NEAR(f_tray, 0.6 * g, 0.01 * 0.6 * g);
+  // the ball (radius 0.11) on the top at 0.75 m: its centre never below 0.75 + 0.11 − margins
+  EXPECT_GT(ball_lowest, 0.86 - 0.005);
+  // the collision world moves the objects' bodies with them
+  EXPECT_LT((w.collisionWorld()->bodyPose(w.objectBody(ball)).p - w.object(ball).pose().p).norm(), 1e-12);
+}
+
+// Fig. 4.17: a hand target driven 10 cm below a table's top; the hand stops on the top (the contact
+// carries the coupling's push) and the real geometry penetrates less than the margin.
+TEST(WorldPhysics, AHandDrivenIntoATableStopsOnIt) {
+  const double top = 0.85;
+  char scene[512];
+  std::snprintf(scene, sizeof scene,
+                "bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"
+                "  - name: table\n    pose: {position: [0.45, -0.25, %.3f]}\n    shape: {type: box, size: [0.3, 0.3, 0.04]}\n",
+                top - 0.02);
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("operator", ""));
+  World w(std::move(setups), physicsConfig(scene));
+  const math::SE3 base = placed(0, 0, 0);
+  const math::Vector3 hang = standingFrame(base, "hand_r").p;
+  // the hand hangs fingers down (standing orientation): up in front of the body first, then over the
+  // table, so that the fingers pass above its front edge
+  const math::Vector3 up(0.15, -0.22, top + 0.35), above(0.40, -0.22, top + 0.25), into(0.40, -0.22, top - 0.10);
+  const auto target = [&](double t) {  // hanging → up (1.5 s) → above the table (1 s) → 10 cm below its top (1 s)
+    if (t < 1.5) return hang + smooth(t / 1.5) * (up - hang);
+    if (t < 2.5) return up + smooth((t - 1.5) / 1.0) * (above - up);
+    return above + smooth((t - 2.5) / 1.0) * (into - above);
+  };
+  w.addMocap(actorFrame(0, base));
+  w.anchor(0);
+  const int table = w.collisionWorld()->findBody("scene/table");
+  const int hand = w.collisionWorld()->segmentBody(0, w.model(0).findSegment("hand_r"));
+  ASSERT_GE(table, 0);
+  ASSERT_GE(hand, 0);
+  const double margin = w.config().physics.segment_margin;
+  double worst_penetration = 0;
+  ASSERT_TRUE(run(w, 0, 5.0, [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base, {{"hand_r", target(t)}})); },
+                  [&](double) {
+                    worst_penetration = std::max(worst_penetration, w.diagnostics().max_penetration_m);
+                    return true;
+                  }));
+  const double pushed = normalForceOn(w, table);
+  double hand_on_table = 0;  // the hand segment's contacts with the table
+  for (const ContactReport& c : w.contacts())
+    if ((c.body_a == hand && c.body_b == table) || (c.body_a == table && c.body_b == hand)) hand_on_table += c.normal_force;
+  const DrivenFrame& hf = w.controlFrames(0)[3];
+  ASSERT_EQ(hf.frame, "hand_r");
+  std::printf("hand 10 cm into a table: target z %.3f, hand frame z %.4f (top %.3f), hand on table %.2f N (table "
+              "total %.2f N), worst penetration %.5f m (margin %.3f)\n",
+              hf.target.p.z(), hf.actual.p.z(), top, hand_on_table, pushed, worst_penetration, margin);
+  EXPECT_GT(hand_on_table, 1.0);                // the hand presses on the table
+  EXPECT_GT(hf.actual.p.z(), top);              // stopped on the top (the frame is at the wrist, above the fingers)
+  EXPECT_GT(hf.position_error, 0.05);           // far from its target: the table holds it
+  EXPECT_LT(worst_penetration, margin);         // the real geometry: less than the margin
+  EXPECT_EQ(w.failedSteps(), 0u);
+}
+
+// Two actors, two mocap sources: they face each other across a 4 kg box with two handles, put their
+// hands on the handles, grasp (bilateral rows), lift it 10 cm and carry it 1 m sideways. No hand slips
+// on its handle (relative pose held within 2 mm and 0.02 rad), the box never drops, each mannequin
+// carries part of its weight, and it arrives 1 m away.
+TEST(WorldPhysics, TwoMannequinsLiftABoxByItsHandlesAndCarryIt1m) {
+  const char* scene =
+      "friction: {default: 0.05}\n"  // the feet slide on the floor as the actors shuffle sideways
+      "bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"
+      "  - name: stand\n    pose: {position: [0, 0, 0.4]}\n    shape: {type: box, size: [0.3, 0.3, 0.8]}\n"
+      "  - name: box\n    movable: true\n    pose: {position: [0, 0, 0.951]}\n    mass: 4\n"
+      "    margin: 0.002\n"  // the box rests 2 mm above its stand: box–box penetration (FCL's EPA) never runs
+      "    inertia: [0.05, 0.07, 0.08]\n"
+      "    shapes:\n"
+      "      - {type: box, size: [0.5, 0.36, 0.3]}\n"
+      "      - {type: box, size: [0.06, 0.24, 0.03], pose: {position: [-0.28, 0, 0.1]}}\n"
+      "      - {type: box, size: [0.06, 0.24, 0.03], pose: {position: [0.28, 0, 0.1]}}\n";
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("alice", "rig_a"));
+  setups.push_back(actorSetup("bob", "rig_b"));
+  World w(std::move(setups), physicsConfig(scene));
+  ASSERT_EQ(w.mocapSources().size(), 3u);  // "" and the two rigs
+  const int box = w.findObject("box");
+  ASSERT_GE(box, 0);
+  const math::SE3 base_a = placed(-0.62, 0, 0), base_b = placed(0.62, 0, M_PI);
+  // handle grip points: the left/right ends of each handle bar, on its top
+  const double hz = 0.951 + 0.1 + 0.015 + 0.03;
+  const auto handTargets = [&](bool a, double lift, double shift) {
+    const double x = a ? -0.28 : 0.28;
+    // alice faces +x: her left hand is at +y; bob faces −x: his left hand is at −y
+    const double yl = a ? 0.09 : -0.09;
+    return std::map<std::string, math::Vector3>{{"hand_l", math::Vector3(x, yl + shift, hz + lift)},
+                                                {"hand_r", math::Vector3(x, -yl + shift, hz + lift)}};
+  };
+  // phases: reach (1.5 s, settle 0.3 s), grasp, lift 10 cm (0.7 s), hold (0.5 s), carry 1 m along +y (2 s), hold (0.3 s)
+  double lift = 0, shift = 0, reach = 0;
+  const auto feed = [&](double t) {
+    for (const bool a : {true, false}) {
+      const math::SE3 base = (a ? base_a : base_b);
+      math::SE3 moved_base = base;
+      moved_base.p.y() += shift;
+      std::map<std::string, math::Vector3> m = handTargets(a, lift, shift);
+      if (reach < 1) {
+        const math::Vector3 hl = standingFrame(base, "hand_l").p, hr = standingFrame(base, "hand_r").p;
+        m["hand_l"] = hl + reach * (m["hand_l"] - hl);
+        m["hand_r"] = hr + reach * (m["hand_r"] - hr);
+      }
+      w.addMocap(actorFrame(ns(t) + 1, moved_base, m), a ? "rig_a" : "rig_b");
+    }
+  };
+  w.addMocap(actorFrame(0, base_a), "rig_a");
+  w.addMocap(actorFrame(0, base_b), "rig_b");
+  w.anchor(0, "rig_a");
+  w.anchor(0, "rig_b");
+  ASSERT_TRUE(w.calibrated(0));
+  ASSERT_TRUE(w.calibrated(1));
+  double t = 0;
+  ASSERT_TRUE(run(w, t, 1.8, [&](double tt) {
+    reach = smooth(tt / 1.5);
+    feed(tt);
+  }));
+  t += 1.8;
+  // grasp where the hands are (the handles between them are what they hold)
+  std::vector<int> handles;
+  for (int m = 0; m < 2; ++m)
+    for (const char* h : {"hand_l", "hand_r"}) {
+      const int g = w.grasp(m, h, "box");
+      ASSERT_GE(g, 0) << w.name(m) << " " << h;
+      handles.push_back(g);
+    }
+  const auto relative = [&](int m, const char* h) {
+    const math::SE3& oMh = w.data(m).oMf[static_cast<std::size_t>(w.model(m).frameIndex(h))];
+    return oMh.inverse() * w.object(box).pose();
+  };
+  std::vector<math::SE3> grip0;
+  for (int m = 0; m < 2; ++m)
+    for (const char* h : {"hand_l", "hand_r"}) grip0.push_back(relative(m, h));
+  const double z0 = w.object(box).pose().p.z(), y0 = w.object(box).pose().p.y();
+  double worst_slip = 0, worst_turn = 0, lowest = 1e9;
+  const auto check = [&](double) {
+    int i = 0;
+    for (int m = 0; m < 2; ++m)
+      for (const char* h : {"hand_l", "hand_r"}) {
+        const math::SE3 d = grip0[static_cast<std::size_t>(i++)].inverse() * relative(m, h);
+        worst_slip = std::max(worst_slip, d.p.norm());
+        worst_turn = std::max(worst_turn, math::logSO3(d.R).norm());
+      }
+    lowest = std::min(lowest, w.object(box).pose().p.z() - z0);
+    return true;
+  };
+  ASSERT_TRUE(run(w, t, 1.2, [&](double tt) {
+    lift = 0.10 * smooth((tt - 1.8) / 0.7);
+    feed(tt);
+  }, check));
+  t += 1.2;
+  const double lifted = w.object(box).pose().p.z() - z0;
+  // held still: the weight is carried by the four grasps, their vertical forces sum to m g
+  double up = 0;
+  for (const int g : handles) up += w.graspForce(g).z();
+  ASSERT_TRUE(run(w, t, 2.3, [&](double tt) {
+    shift = 1.0 * smooth((tt - 3.0) / 2.0);
+    feed(tt);
+  }, check));
+  const double moved = w.object(box).pose().p.y() - y0;
+  std::printf("two mannequins carry a 4 kg box: lifted %.4f m, grasps carry %.3f N (m g = %.3f N), moved %.4f m, "
+              "worst hand slip %.2e m / %.2e rad, lowest %.4f m below the start, %d contacts\n",
+              lifted, up, 4 * 9.81, moved, worst_slip, worst_turn, -lowest, w.diagnostics().contacts);
+  EXPECT_GT(lifted, 0.07);                        // lifted off its stand (10 cm target)
+  EXPECT_NEAR(up, 4 * 9.81, 0.02 * 4 * 9.81);     // the hands carry its weight (a first-order body at rest)
+  EXPECT_NEAR(moved, 1.0, 0.05);                  // carried 1 m
+  EXPECT_LT(worst_slip, 2e-3);                    // no hand slips on its handle
+  EXPECT_LT(worst_turn, 0.02);
+  EXPECT_GT(lowest, -0.01);                       // the box never drops
+  EXPECT_EQ(w.failedSteps(), 0u);
+  for (const int g : handles) EXPECT_TRUE(w.release(g));
+  EXPECT_FALSE(w.release(handles[0]));
+}
+
+TEST(WorldPhysics, GraspErrorsNameWhatIsWrong) {
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("operator", ""));
+  SimConfig cfg;
+  cfg.physics.enabled = true;
+  cfg.physics.scene = collision::loadScene("configs/scenes/table.yaml");
+  World w(std::move(setups), cfg);
+  const auto message = [&](int m, const std::string& f, const std::string& o) {
+    try {
+      w.grasp(m, f, o);
+    } catch (const std::invalid_argument& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  EXPECT_NE(message(0, "hand_x", "ball").find("hand_x"), std::string::npos);
+  EXPECT_NE(message(0, "hand_l", "anvil").find("anvil"), std::string::npos);
+  EXPECT_NE(message(3, "hand_l", "ball").find("3"), std::string::npos);
+  EXPECT_FALSE(w.addMocap(actorFrame(0, placed(0, 0, 0)), "no_such_rig"));
+  EXPECT_EQ(w.latestMocap("no_such_rig"), nullptr);
+}
