@@ -13,6 +13,7 @@
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/control/config.hpp"
 #include "mannequin/math/so3.hpp"
+#include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
@@ -350,4 +351,71 @@ TEST(WorldPhysics, GraspErrorsNameWhatIsWrong) {
   EXPECT_NE(message(3, "hand_l", "ball").find("3"), std::string::npos);
   EXPECT_FALSE(w.addMocap(actorFrame(0, placed(0, 0, 0)), "no_such_rig"));
   EXPECT_EQ(w.latestMocap("no_such_rig"), nullptr);
+}
+
+// 60 s standing with both hands pressed on a table (their targets 2 cm below its top): the contacts
+// hold the hands and the energy stays bounded — after the hands have settled (10 s), the constraint
+// forces do no net work (a port that injected energy would show chattering or drift), the mannequin
+// stops moving, and the hands stay on the table without penetrating beyond the margin.
+TEST(WorldPhysics, SixtySecondsWithBothHandsOnATableKeepTheEnergyBounded) {
+  const double top = 0.85;
+  const std::string scene =
+      "bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"
+      "  - name: table\n    pose: {position: [0.45, 0, 0.83]}\n    shape: {type: box, size: [0.3, 0.8, 0.04]}\n";
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("operator", ""));
+  World w(std::move(setups), physicsConfig(scene));
+  const math::SE3 base = placed(0, 0, 0);
+  std::map<std::string, math::Vector3> hang, up, on;
+  for (const char* h : {"hand_l", "hand_r"}) {
+    hang[h] = standingFrame(base, h).p;
+    const double y = hang[h].y();
+    up[h] = math::Vector3(0.15, y, top + 0.35);
+    on[h] = math::Vector3(0.40, y, top - 0.02);
+  }
+  const auto targets = [&](double t) {
+    std::map<std::string, math::Vector3> m;
+    for (const char* h : {"hand_l", "hand_r"}) {
+      const std::string k = h;
+      m[k] = t < 1.5 ? hang[k] + smooth(t / 1.5) * (up[k] - hang[k]) : up[k] + smooth((t - 1.5) / 1.5) * (on[k] - up[k]);
+    }
+    return m;
+  };
+  w.addMocap(actorFrame(0, base));
+  w.anchor(0);
+  const auto* cs = dynamic_cast<const ControllerStepper*>(&w.stepper(0));
+  ASSERT_NE(cs, nullptr);
+  const control::Controller& ctl = cs->controller();
+  const int table = w.collisionWorld()->findBody("scene/table");
+  const int hand_l = w.collisionWorld()->segmentBody(0, w.model(0).findSegment("hand_l"));
+  const int hand_r = w.collisionWorld()->segmentBody(0, w.model(0).findSegment("hand_r"));
+  const auto feed = [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base, targets(t)), ""); };
+  ASSERT_TRUE(run(w, 0, 10.0, feed));
+  const double e_constraint0 = ctl.constraintPort().energy, e_internal0 = ctl.internalPort().energy;
+  double max_speed = 0, worst_penetration = 0;
+  long steps_both_on = 0, steps = 0;
+  ASSERT_TRUE(run(w, 10.0, 50.0, feed, [&](double) {
+    max_speed = std::max(max_speed, w.qdot(0).tail(w.model(0).nv - 6).cwiseAbs().maxCoeff());
+    worst_penetration = std::max(worst_penetration, w.diagnostics().max_penetration_m);
+    bool l = false, r = false;
+    for (const ContactReport& c : w.contacts()) {
+      if (c.normal_force <= 0 || (c.body_a != table && c.body_b != table)) continue;
+      l = l || c.body_a == hand_l || c.body_b == hand_l;
+      r = r || c.body_a == hand_r || c.body_b == hand_r;
+    }
+    steps_both_on += (l && r) ? 1 : 0;
+    ++steps;
+    return true;
+  }));
+  const double de_constraint = ctl.constraintPort().energy - e_constraint0;
+  const double de_internal = ctl.internalPort().energy - e_internal0;
+  std::printf("60 s, both hands on a table: constraint port %.3e J and internal port %.3e J over the last 50 s, max "
+              "joint speed %.2e rad/s, both hands pressing in %ld/%ld steps, worst penetration %.5f m\n",
+              de_constraint, de_internal, max_speed, steps_both_on, steps, worst_penetration);
+  EXPECT_LT(std::abs(de_constraint), 0.05);  // J: no energy injected by the contacts at rest
+  EXPECT_LT(std::abs(de_internal), 0.05);
+  EXPECT_LT(max_speed, 0.01);                // rad/s: at rest, no oscillation building up
+  EXPECT_EQ(steps_both_on, steps);
+  EXPECT_LT(worst_penetration, w.config().physics.segment_margin);
+  EXPECT_EQ(w.failedSteps(), 0u);
 }
