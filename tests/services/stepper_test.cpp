@@ -262,7 +262,7 @@ CaptureRun runCapture(bool controller) {
   }
   r.failed = w.failedSteps();
   if (const auto* cs = dynamic_cast<const ControllerStepper*>(&w.stepper(0)); cs && cs->jointLimits())
-    r.lcp_failures = cs->jointLimits()->failures();
+    r.lcp_failures = cs->constraintFailures();
   r.mean_hand /= static_cast<double>(std::max(r.states, 1L));
   r.mean_pelvis /= static_cast<double>(std::max(r.states, 1L));
   return r;

@@ -11,7 +11,6 @@ ControllerStepper::ControllerStepper(const skeleton::Model& model, control::Cont
                                      const std::vector<int>& frames, double dt, const skeleton::VectorX& q0,
                                      std::optional<constraints::JointLimitOptions> limits)
     : model_(model), data_(model), dt_(dt) {
-  if (limits) limits_.emplace(model, *limits);
   if (!(dt > 0) || !std::isfinite(dt)) throw std::invalid_argument("controller stepper: step must be > 0");
   config.dt = dt;
   controller_ = std::make_unique<control::Controller>(model, config, q0);
@@ -44,6 +43,17 @@ ControllerStepper::ControllerStepper(const skeleton::Model& model, control::Cont
   // frames no mocap body drives would pin their segment where it stood: off
   for (int c = 0; c < controller_->numFrames(); ++c)
     if (!used[c]) controller_->setFrameEnabled(c, false);
+  if (limits) {
+    system_ = std::make_unique<constraints::MannequinSystem>(*controller_);
+    limits_ = std::make_unique<constraints::JointLimitRows>(*controller_, 0, *limits);
+    // joint limits only: at most two rows per coordinate (a swing and a twist row per ball joint)
+    constraints::SolverOptions so;
+    so.max_rows = 2 * model.nv;
+    so.max_friction_rows = 1;
+    so.max_edges = 1;
+    solver_ = std::make_unique<constraints::ConstraintSolver>(std::vector<constraints::ConstrainedSystem*>{system_.get()}, so);
+    solver_->addProducer(limits_.get());
+  }
   skeleton::forwardKinematics(model_, data_, controller_->q());
   skeleton::centerOfMass(model_, data_);
 }
@@ -80,13 +90,13 @@ void ControllerStepper::reset(const skeleton::VectorX& q) {
 
 bool ControllerStepper::step(double dt) { return beginStep(dt, true) && endStep(); }
 
-bool ControllerStepper::beginStep(double dt, bool own_limits) {
+bool ControllerStepper::beginStep(double dt, bool own_constraints) {
   if (std::abs(dt - dt_) > 1e-12 * dt_)
     throw std::logic_error("controller stepper: step " + std::to_string(dt) + " s, built for " + std::to_string(dt_) + " s");
   if (controller_->computeFreeMotion() != control::StepStatus::kOk) return false;
-  // unilateral constraints (Alg. 4): their force joins q̇ before the integration; a failed LCP leaves
-  // the step unconstrained (counted in jointLimits()->failures())
-  if (own_limits && limits_) limits_->apply(*controller_);
+  // unilateral constraints (Alg. 4): their force joins q̇ before the integration; a failed solve leaves
+  // the step unconstrained (counted in constraintFailures())
+  if (own_constraints && solver_ && solver_->solve(dt).solver == constraints::SolverUsed::kFailed) ++failures_;
   return true;
 }
 

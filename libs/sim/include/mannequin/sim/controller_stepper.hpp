@@ -12,9 +12,12 @@
 /// Weight w ∈ [0, 1]: K = w K₀, B = w B₀ (K₀, B₀ from the config, weight applied); w = 0 switches the
 /// frame off, so its rows leave the projectors and the posture control takes the limb (2.25).
 ///
-/// The step is the controller's: computeFreeMotion(); the unilateral constraints (today the joint limits,
-/// constraints::JointLimits, an LCP on J_c b⁻¹ J_cᵀ; contacts join with the constraint solver); then
-/// integrate(); then the forward kinematics at q_{k+1} (oMi, oMf, com) for data(). dt must equal the
+/// The step is the controller's (Alg. 4): computeFreeMotion(); stage 2, the unilateral constraints as
+/// rows of a constraints::ConstraintSolver over the producers this stepper owns (the joint limits:
+/// constraints::JointLimitRows, revolute bounds and the ball joints' swing ellipse and twist range,
+/// Annex D.2) — or, in the World's physics, of the World's shared solver with the contacts, balance and
+/// grasps; then integrate(); then the forward kinematics at q_{k+1} (oMi, oMf, com) for data(). A failed
+/// solve applies no force and is counted (constraintFailures()); it never throws. dt must equal the
 /// controller's δt (the constructor sets the controller's δt to the World's step).
 #include <memory>
 #include <vector>
@@ -22,6 +25,8 @@
 #include <optional>
 
 #include "mannequin/constraints/joint_limits.hpp"
+#include "mannequin/constraints/solver.hpp"
+#include "mannequin/constraints/system.hpp"
 #include "mannequin/control/controller.hpp"
 #include "mannequin/sim/stepper.hpp"
 
@@ -42,9 +47,9 @@ class ControllerStepper final : public Stepper {
   bool step(double dt) override;
   /// The step in two halves, for the World's physics (the shared constraint solver runs between them):
   /// beginStep = stage 1 (free motion at q_k; the controller's data() holds q_k's kinematics and
-  /// Jacobians) and this stepper's own joint limits when `own_limits`; endStep = stage 3 (integration)
-  /// and the kinematics at q_{k+1}. step() = beginStep(dt, true) + endStep().
-  bool beginStep(double dt, bool own_limits);
+  /// Jacobians) and, when `own_constraints`, stage 2 with this stepper's own solver; endStep = stage 3
+  /// (integration) and the kinematics at q_{k+1}. step() = beginStep(dt, true) + endStep().
+  bool beginStep(double dt, bool own_constraints);
   bool endStep();
   const skeleton::VectorX& q() const override { return controller_->q(); }
   const skeleton::VectorX& qdot() const override { return controller_->qdot(); }
@@ -57,8 +62,12 @@ class ControllerStepper final : public Stepper {
   control::Controller& controller() { return *controller_; }
   /// Controller control frame driven by the World's control frame i.
   int controllerFrame(int i) const { return map_.at(i).index; }
-  /// The joint-limit constraints (nullptr when off).
-  const constraints::JointLimits* jointLimits() const { return limits_ ? &*limits_ : nullptr; }
+  /// The joint-limit rows of this stepper's own solver (nullptr when off).
+  const constraints::JointLimitRows* jointLimits() const { return limits_.get(); }
+  /// This stepper's own solver (system 0: the controller), nullptr when it has no producer.
+  const constraints::ConstraintSolver* constraintSolver() const { return solver_.get(); }
+  /// Own solves that failed (no force applied that step).
+  long constraintFailures() const { return failures_; }
 
  private:
   struct Driven {
@@ -71,7 +80,10 @@ class ControllerStepper final : public Stepper {
   const skeleton::Model& model_;
   std::unique_ptr<control::Controller> controller_;
   std::vector<Driven> map_;
-  std::optional<constraints::JointLimits> limits_;
+  std::unique_ptr<constraints::MannequinSystem> system_;
+  std::unique_ptr<constraints::JointLimitRows> limits_;
+  std::unique_ptr<constraints::ConstraintSolver> solver_;
+  long failures_ = 0;
   skeleton::Data data_;
   double dt_;
 };
