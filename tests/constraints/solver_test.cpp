@@ -384,3 +384,77 @@ TEST(ConstraintSolver, ManyDenseRowsAreComplementary) {
               solverUsedName(rep.solver), lcp::statusName(rep.lemke_status), rep.lcp_size, rep.active, rep.pivots,
               rep.assemble_s * 1e6, rep.solve_s * 1e6);
 }
+
+namespace {
+/// A 2-D point kept inside the unit disk: d = 1 − |x|, J = −xᵀ/|x| (curved: the linear row leaves
+/// (δt v_t)²/2 outside when the point slides along the circle at tangential speed v_t). refine()
+/// returns the exact distance at the answer's velocity.
+class DiskProducer final : public RowProducer {
+ public:
+  explicit DiskProducer(const PointSystem& sys) : sys_(&sys) {}
+  const char* name() const override { return "disk"; }
+  void addRows(int id, double /*dt*/, RowSet& rows) override {
+    const Eigen::Vector2d x = sys_->x.head<2>();
+    RowInfo in;
+    in.producer = id;
+    in.distance = 1.0 - x.norm();
+    in.system_a = 0;
+    row_ = rows.add(in);
+    if (row_ >= 0) rows.jacobian(row_, 0).head<2>() = -x.normalized();
+  }
+  bool refine(int /*id*/, double dt, RowSet& rows, const std::vector<Eigen::VectorXd>& velocity) override {
+    if (row_ < 0) return false;
+    const Eigen::Vector2d x = sys_->x.head<2>(), v = velocity[0].head<2>();
+    RowInfo& in = rows.info(row_);
+    const double next = 1.0 - (x + dt * v).norm();
+    const double c = next - (in.distance + dt * rows.jacobians(0).row(row_).head<2>().dot(v));
+    const bool again = std::abs(c - in.correction) > 1e-12;
+    in.correction = c;
+    ++refines;
+    return again;
+  }
+  int refines = 0;
+
+ private:
+  const PointSystem* sys_;
+  int row_ = -1;
+};
+
+/// Max over 300 steps of how far the point is outside the disk, pushed outwards and along the circle.
+double worstDiskExcess(int refine_rounds, int* rounds = nullptr) {
+  PointSystem sys(2, 1, 1.0, 1.0);  // b = 1: q̇ = Γ
+  sys.x << 0.9, 0.0;
+  DiskProducer disk(sys);
+  SolverOptions opt;
+  opt.refine_rounds = refine_rounds;
+  ConstraintSolver solver({&sys}, opt);
+  solver.addProducer(&disk);
+  const double dt = 0.01;
+  double worst = 0.0;
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector2d r = sys.x.head<2>().normalized(), t(-r.y(), r.x());
+    sys.freeMotion(5.0 * t + 2.0 * r);  // 5 m/s along the circle, 2 m/s outwards
+    const SolveReport& rep = solver.solve(dt);
+    EXPECT_EQ(rep.solver, SolverUsed::kLemke);
+    if (rounds) *rounds = std::max(*rounds, rep.refine_rounds);
+    sys.integrate(dt);
+    worst = std::max(worst, sys.x.head<2>().norm() - 1.0);
+  }
+  return worst;
+}
+}  // namespace
+
+TEST(ConstraintSolver, RefinementKeepsACurvedRowAtTheNextStepNotOnlyToFirstOrder) {
+  // first order: sliding at 5 m/s along the unit circle leaves ≈ (δt v)²/2 = 1.25e-3 m outside
+  const double linear = worstDiskExcess(0);
+  EXPECT_GT(linear, 1e-3);
+  EXPECT_LT(linear, 1.5e-3);
+  // refined: the exact distance at the answer's velocity; the fixed point contracts by ~δt v/R = 0.05
+  // per round, so a few rounds reach the producer's 1e-12
+  int rounds = 0;
+  const double refined = worstDiskExcess(6, &rounds);
+  EXPECT_LT(refined, 1e-10);
+  EXPECT_GE(rounds, 1);
+  EXPECT_LE(rounds, 6);
+  std::printf("disk: worst excess %.3g m first order, %.3g m refined (at most %d rounds)\n", linear, refined, rounds);
+}

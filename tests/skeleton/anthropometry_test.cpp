@@ -185,7 +185,7 @@ TEST(Anthropometry, BallJointsGetSwingTwistLimitsFromTheBoxesOrTheConfig) {
   EXPECT_NEAR(hip.twist_upper, 45 * kD, 1e-12);
   // the neck's axis is +z (head above): twist = the z box
   EXPECT_LT((m.joints[m.jointIndex("neck")].ball_limit.twist_axis - Vector3::UnitZ()).norm(), 1e-12);
-  // shoulder_l: the box's inscribed ellipse reaches past 170°: scaled about 0 to reach 170° exactly
+  // shoulder_l: the box's inscribed ellipse reaches past 150° (kMaxSwing): scaled about 0 to reach it
   const BallLimit& sh = m.joints[m.jointIndex("shoulder_l")].ball_limit;
   EXPECT_NEAR(sh.maxSwing(), BallLimit::kMaxSwing, 1e-6);
   EXPECT_NEAR(sh.swing_cx / sh.swing_a, 70.0 / 100.0, 1e-12);

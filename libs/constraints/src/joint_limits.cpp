@@ -152,6 +152,9 @@ JointLimitRows::JointLimitRows(const control::Controller& controller, int system
     }
   }
   rows_.reserve(2 * boxes_.size() + 3 * balls_.size());
+  ball_rows_.reserve(3 * balls_.size());
+  box_rows_.assign(2 * boxes_.size(), 0);
+  ball_has_rows_.assign(balls_.size(), 0);
 }
 
 int JointLimitRows::activeCount() const {
@@ -160,12 +163,15 @@ int JointLimitRows::activeCount() const {
   return n;
 }
 
-void JointLimitRows::add(int id, double dt, RowSet& rows, RowSource source, int coordinate, bool upper,
-                         double d, int v, int ncols, const double* jac) {
+bool JointLimitRows::candidate(double dt, double d, int v, int ncols, const double* jac) const {
   const Eigen::VectorXd& qf = ctl_->qdotFree();
   double rate = 0.0;
   for (int c = 0; c < ncols; ++c) rate += jac[c] * qf(v + c);
-  if (std::min(d, d + dt * rate) >= options_.activation) return;
+  return std::min(d, d + dt * rate) < options_.activation;
+}
+
+int JointLimitRows::add(int id, RowSet& rows, RowSource source, int coordinate, bool upper, double d, int v,
+                        int ncols, const double* jac, double correction) {
   RowInfo info;
   info.kind = RowKind::kUnilateral;
   info.source = source;
@@ -174,45 +180,151 @@ void JointLimitRows::add(int id, double dt, RowSet& rows, RowSource source, int 
   info.distance = d;
   info.recovery_speed = options_.recovery_speed;
   info.system_a = system_;
+  info.correction = correction;
   const int r = rows.add(info);
   if (r >= 0) {
     auto J = rows.jacobian(r, system_);
     for (int c = 0; c < ncols; ++c) J(v + c) = jac[c];
   }
   rows_.push_back({coordinate, upper, d, 0.0, source, r});
+  return r;
+}
+
+void JointLimitRows::addBox(int id, RowSet& rows, std::size_t bi, bool upper, double correction) {
+  const Box& b = boxes_[bi];
+  const Eigen::VectorXd& q = ctl_->q();
+  const double d = upper ? b.upper - q(b.q) : q(b.q) - b.lower;
+  Eigen::RowVector3d row(upper ? -1.0 : 1.0, 0.0, 0.0);
+  if (b.component >= 0)  // q̇ = Jr(q)⁻¹ω on the ball's three columns
+    row = (upper ? -1.0 : 1.0) * math::rightJacobianInverseSO3(q.segment<3>(b.ball_q)).row(b.component);
+  add(id, rows, RowSource::kJointLimit, b.q, upper, d, b.v, b.component < 0 ? 1 : 3, row.data(), correction);
+  box_rows_[2 * bi + (upper ? 1 : 0)] = 1;
+}
+
+void JointLimitRows::addBall(int id, RowSet& rows, std::size_t bi, const BallLimitDistances& d,
+                             const double* correction) {
+  const int ji = balls_[bi];
+  const skeleton::Joint& j = ctl_->model().joints[static_cast<std::size_t>(ji)];
+  ball_has_rows_[bi] = 1;
+  if (d.singular) {
+    const int r = add(id, rows, RowSource::kSwing, j.idx_q, false, d.swing, j.idx_v, 3, d.swing_jacobian.data(),
+                      correction ? correction[0] : 0.0);
+    ball_rows_.push_back({r, ji, 0, true, d.swing, 0.0});
+    return;
+  }
+  const Eigen::RowVector3d neg = -d.twist_jacobian;
+  int r = add(id, rows, RowSource::kSwing, j.idx_q, false, d.swing, j.idx_v, 3, d.swing_jacobian.data(),
+              correction ? correction[0] : 0.0);
+  ball_rows_.push_back({r, ji, 0, false, d.swing, d.swing_scale});
+  r = add(id, rows, RowSource::kTwist, j.idx_q, false, d.twist_lower, j.idx_v, 3, d.twist_jacobian.data(),
+          correction ? correction[1] : 0.0);
+  ball_rows_.push_back({r, ji, 1, false, d.twist_lower, 0.0});
+  r = add(id, rows, RowSource::kTwist, j.idx_q, true, d.twist_upper, j.idx_v, 3, neg.data(),
+          correction ? correction[2] : 0.0);
+  ball_rows_.push_back({r, ji, 2, false, d.twist_upper, 0.0});
 }
 
 void JointLimitRows::addRows(int id, double dt, RowSet& rows) {
   const Eigen::VectorXd& q = ctl_->q();
   const skeleton::Model& model = ctl_->model();
   rows_.clear();
+  ball_rows_.clear();
+  std::fill(box_rows_.begin(), box_rows_.end(), 0);
+  std::fill(ball_has_rows_.begin(), ball_has_rows_.end(), 0);
   worst_excess_ = 0.0;
-  for (const Box& b : boxes_) {
+  for (std::size_t bi = 0; bi < boxes_.size(); ++bi) {
+    const Box& b = boxes_[bi];
     double lo_d = q(b.q) - b.lower, hi_d = b.upper - q(b.q);
     worst_excess_ = std::max({worst_excess_, std::isfinite(lo_d) ? -lo_d : 0.0, std::isfinite(hi_d) ? -hi_d : 0.0});
-    if (b.component < 0) {
-      const double plus = 1.0, minus = -1.0;
-      if (std::isfinite(b.lower)) add(id, dt, rows, RowSource::kJointLimit, b.q, false, lo_d, b.v, 1, &plus);
-      if (std::isfinite(b.upper)) add(id, dt, rows, RowSource::kJointLimit, b.q, true, hi_d, b.v, 1, &minus);
-    } else {
-      // q̇ = Jr(q)⁻¹ω on the ball's three columns
-      const Eigen::RowVector3d row = math::rightJacobianInverseSO3(q.segment<3>(b.ball_q)).row(b.component);
-      const Eigen::RowVector3d neg = -row;
-      if (std::isfinite(b.lower)) add(id, dt, rows, RowSource::kJointLimit, b.q, false, lo_d, b.v, 3, row.data());
-      if (std::isfinite(b.upper)) add(id, dt, rows, RowSource::kJointLimit, b.q, true, hi_d, b.v, 3, neg.data());
-    }
+    Eigen::RowVector3d row(1.0, 0.0, 0.0);
+    if (b.component >= 0) row = math::rightJacobianInverseSO3(q.segment<3>(b.ball_q)).row(b.component);
+    const Eigen::RowVector3d neg = -row;
+    const int nc = b.component < 0 ? 1 : 3;
+    if (std::isfinite(b.lower) && candidate(dt, lo_d, b.v, nc, row.data())) addBox(id, rows, bi, false, 0.0);
+    if (std::isfinite(b.upper) && candidate(dt, hi_d, b.v, nc, neg.data())) addBox(id, rows, bi, true, 0.0);
   }
-  for (int ji : balls_) {
-    const skeleton::Joint& j = model.joints[ji];
+  for (std::size_t bi = 0; bi < balls_.size(); ++bi) {
+    const skeleton::Joint& j = model.joints[static_cast<std::size_t>(balls_[bi])];
     const BallLimitDistances d = ballLimitDistances(j.ball_limit, math::expSO3(q.segment<3>(j.idx_q)));
     worst_excess_ = std::max(worst_excess_, d.swing_excess);
-    add(id, dt, rows, RowSource::kSwing, j.idx_q, false, d.swing, j.idx_v, 3, d.swing_jacobian.data());
-    if (d.singular) continue;  // the twist is undefined near swing π: the swing row brings it back first
-    worst_excess_ = std::max({worst_excess_, -d.twist_lower, -d.twist_upper});
+    if (!d.singular) worst_excess_ = std::max({worst_excess_, -d.twist_lower, -d.twist_upper});
+    // near swing π only the radial swing row (the twist is undefined there); else all three rows
+    // when one is a candidate (see the header)
     const Eigen::RowVector3d neg = -d.twist_jacobian;
-    add(id, dt, rows, RowSource::kTwist, j.idx_q, false, d.twist_lower, j.idx_v, 3, d.twist_jacobian.data());
-    add(id, dt, rows, RowSource::kTwist, j.idx_q, true, d.twist_upper, j.idx_v, 3, neg.data());
+    if (candidate(dt, d.swing, j.idx_v, 3, d.swing_jacobian.data()) ||
+        (!d.singular && (candidate(dt, d.twist_lower, j.idx_v, 3, d.twist_jacobian.data()) ||
+                         candidate(dt, d.twist_upper, j.idx_v, 3, neg.data()))))
+      addBall(id, rows, bi, d, nullptr);
   }
+}
+
+bool JointLimitRows::refine(int id, double dt, RowSet& rows, const std::vector<Eigen::VectorXd>& velocity) {
+  if (system_ >= static_cast<int>(velocity.size())) return false;
+  constexpr double kTolerance = 1e-9;  // rad: a correction that moved less needs no new solve
+  const Eigen::VectorXd& v = velocity[static_cast<std::size_t>(system_)];
+  const Eigen::VectorXd& q = ctl_->q();
+  const skeleton::Model& model = ctl_->model();
+  bool again = false;
+  // 1. the rows of the step: their linearisation error at this velocity
+  int joint = -1;
+  BallLimitDistances next;
+  const std::size_t n_ball_rows = ball_rows_.size();
+  for (std::size_t k = 0; k < n_ball_rows; ++k) {
+    const BallRow& b = ball_rows_[k];
+    if (b.row < 0) continue;
+    const skeleton::Joint& j = model.joints[static_cast<std::size_t>(b.joint)];
+    const skeleton::BallLimit& l = j.ball_limit;
+    const Eigen::Vector3d w = v.segment<3>(j.idx_v);
+    if (b.joint != joint) {  // where the step takes the ball: R_k exp(δt ω), as the controller integrates
+      next = ballLimitDistances(l, math::expSO3(q.segment<3>(j.idx_q)) * math::expSO3(dt * w));
+      joint = b.joint;
+    }
+    double d_next;
+    if (b.kind == 0)
+      d_next = b.singular ? ellipseRadius(l, next.st.swing_dir) - next.st.swing_angle
+                          : b.scale * (1.0 - ellipseLevel(l, next.st.swing));
+    else if (next.singular)
+      continue;  // the twist is undefined there: the swing row brings the ball back first
+    else
+      d_next = b.kind == 1 ? next.st.twist - l.twist_lower : l.twist_upper - next.st.twist;
+    const double linear = b.d + dt * rows.jacobians(system_).row(b.row).segment<3>(j.idx_v).dot(w);
+    const double c = d_next - linear;
+    if (!std::isfinite(c)) continue;
+    RowInfo& in = rows.info(b.row);
+    if ((in.lambda > 0.0 || d_next < 0.0) && std::abs(c - in.correction) > kTolerance) again = true;
+    in.correction = c;
+  }
+  // 2. late rows: limits without a row that this velocity carries past (the forces at the other rows
+  // move them too); they join with their correction and the solver assembles again
+  for (std::size_t bi = 0; bi < boxes_.size(); ++bi) {
+    const Box& b = boxes_[bi];
+    const double rate = b.component < 0 ? v(b.v)
+                                        : math::rightJacobianInverseSO3(q.segment<3>(b.ball_q)).row(b.component).dot(
+                                              v.segment<3>(b.v));
+    const double next = q(b.q) + dt * rate;
+    if (!box_rows_[2 * bi] && std::isfinite(b.lower) && next < b.lower) addBox(id, rows, bi, false, 0.0);
+    if (!box_rows_[2 * bi + 1] && std::isfinite(b.upper) && next > b.upper) addBox(id, rows, bi, true, 0.0);
+  }
+  for (std::size_t bi = 0; bi < balls_.size(); ++bi) {
+    if (ball_has_rows_[bi]) continue;
+    const skeleton::Joint& j = model.joints[static_cast<std::size_t>(balls_[bi])];
+    const skeleton::BallLimit& l = j.ball_limit;
+    const Eigen::Vector3d w = v.segment<3>(j.idx_v);
+    const Eigen::Matrix3d R = math::expSO3(q.segment<3>(j.idx_q));
+    const BallLimitDistances n1 = ballLimitDistances(l, R * math::expSO3(dt * w));
+    if (n1.swing_excess <= 0.0 && (n1.singular || (n1.twist_lower >= 0.0 && n1.twist_upper >= 0.0))) continue;
+    const BallLimitDistances d = ballLimitDistances(l, R);
+    double c[3];
+    c[0] = (d.singular ? ellipseRadius(l, n1.st.swing_dir) - n1.st.swing_angle
+                       : d.swing_scale * (1.0 - ellipseLevel(l, n1.st.swing))) -
+           (d.swing + dt * d.swing_jacobian.dot(w));
+    const double rate_t = dt * d.twist_jacobian.dot(w);
+    c[1] = n1.singular ? 0.0 : (n1.st.twist - l.twist_lower) - (d.twist_lower + rate_t);
+    c[2] = n1.singular ? 0.0 : (l.twist_upper - n1.st.twist) - (d.twist_upper - rate_t);
+    for (double& x : c) x = std::isfinite(x) ? x : 0.0;
+    addBall(id, rows, bi, d, c);
+  }
+  return again;
 }
 
 void JointLimitRows::solved(int /*id*/, const RowSet& rows) {

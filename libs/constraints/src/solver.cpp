@@ -29,9 +29,11 @@ double seconds(Clock::time_point a, Clock::time_point b) { return std::chrono::d
 std::vector<int> systemSizes(const std::vector<ConstrainedSystem*>& systems, const SolverOptions& o) {
   if (systems.empty()) throw std::invalid_argument("ConstraintSolver: no system");
   if (systems.size() > 64) throw std::invalid_argument("ConstraintSolver: more than 64 systems");
-  if (o.max_rows < 1 || o.max_friction_rows < 0 || o.max_friction_rows > o.max_rows || o.max_edges < 1)
+  if (o.max_rows < 1 || o.max_friction_rows < 0 || o.max_friction_rows > o.max_rows || o.max_edges < 1 ||
+      o.refine_rounds < 0)
     throw std::invalid_argument(
-        "ConstraintSolver: options need max_rows >= 1, 0 <= max_friction_rows <= max_rows, max_edges >= 1");
+        "ConstraintSolver: options need max_rows >= 1, 0 <= max_friction_rows <= max_rows, max_edges >= 1, "
+        "refine_rounds >= 0");
   std::vector<int> nv;
   for (std::size_t s = 0; s < systems.size(); ++s) {
     if (systems[s] == nullptr) throw std::invalid_argument("ConstraintSolver: system " + std::to_string(s) + " is null");
@@ -53,9 +55,12 @@ struct ConstraintSolver::Impl {
   std::vector<Eigen::MatrixXd> R;        // per system: cap_f × nv_s, force rows R_s
   std::vector<Eigen::MatrixXd> X;        // per system: nv_s × cap_f, L_s⁻¹ R_sᵀ
   std::vector<Eigen::VectorXd> gamma;    // per system: nv_s, Γ_s
+  std::vector<Eigen::VectorXd> velocity; // per system: nv_s, q̇_s of the current answer (refinement)
   std::vector<int> pos, neg, edge, gam;  // per row: index of λ (+ half), − half, first edge, γ
   Eigen::MatrixXd M;                     // grows: n × n
   Eigen::VectorXd q;                     // cap_n
+  Eigen::VectorXd q_base;                // cap_n: q without the distance terms (refinement)
+  Eigen::VectorXd z_prev;                // cap_n: the answer before a re-solve (refinement)
   Eigen::MatrixXd A;                     // cap_nn × Σ nv_s: frictionless A = [R_s L_s⁻ᵀ]_s
   lcp::LcpResult result;                 // cap_n
   lcp::LemkeWorkspace lemke;
@@ -87,6 +92,7 @@ ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, cons
     im.R.emplace_back(Eigen::MatrixXd::Zero(im.cap_f, nv));
     im.X.emplace_back(Eigen::MatrixXd::Zero(nv, im.cap_f));
     im.gamma.emplace_back(Eigen::VectorXd::Zero(nv));
+    im.velocity.emplace_back(Eigen::VectorXd::Zero(nv));
     im.m_total += nv;
   }
   const auto mr = static_cast<std::size_t>(options.max_rows);
@@ -95,6 +101,8 @@ ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, cons
   im.edge.assign(mr, -1);
   im.gam.assign(mr, -1);
   im.q = Eigen::VectorXd::Zero(im.cap_n);
+  im.q_base = Eigen::VectorXd::Zero(im.cap_n);
+  im.z_prev = Eigen::VectorXd::Zero(im.cap_n);
   im.A = Eigen::MatrixXd::Zero(im.cap_nn, im.m_total);
   im.result.reserve(im.cap_n);
   im.structured.reserve(im.cap_nn, im.m_total);
@@ -126,132 +134,191 @@ const SolveReport& ConstraintSolver::solve(double dt) {
   // 1. rows
   rows_.clear();
   for (std::size_t p = 0; p < producers_.size(); ++p) producers_[p]->addRows(static_cast<int>(p), dt, rows_);
-  const int nr = rows_.size();
   const int ns = rows_.numSystems();
-  rep.rows = nr;
-  rep.dropped = rows_.dropped();
   const auto t1 = Clock::now();
   rep.produce_s = seconds(t0, t1);
-  if (nr == 0) {
+  if (rows_.size() == 0) {
     for (std::size_t p = 0; p < producers_.size(); ++p) producers_[p]->solved(static_cast<int>(p), rows_);
     return rep;
   }
-  // 2. assembly: indices
-  int nN = 0, nE = 0, nG = 0;
+  lcp::LcpResult& res = im.result;
+  int nr = 0, nN = 0, nF = 0, nz = 0, col = 0;  // nz: force rows of the answer
   std::uint64_t touched = 0;
-  for (int r = 0; r < nr; ++r) {
-    const RowInfo& in = rows_.info(r);
-    const auto ur = static_cast<std::size_t>(r);
-    im.pos[ur] = nN++;
-    im.neg[ur] = in.kind == RowKind::kBilateral ? nN++ : -1;
-    for (int s = 0; s < ns; ++s) touched |= rows_.touches(r, s) ? std::uint64_t{1} << s : 0;
-  }
-  for (int r = 0; r < nr; ++r) {
-    const auto ur = static_cast<std::size_t>(r);
-    if (rows_.frictionSlot(r) >= 0) {
-      im.edge[ur] = nN + nE;
-      nE += rows_.info(r).friction_edges;
-      ++nG;
-    } else {
-      im.edge[ur] = -1;
+  int rounds_left = options_.refine_rounds;
+  auto t2 = t1;
+  // steps 2–3 (and 5) — again from the assembly when a refine() added rows
+  for (bool assemble = true; assemble;) {
+    assemble = false;
+    nr = rows_.size();
+    rep.rows = nr;
+    rep.dropped = rows_.dropped();
+    // 2. assembly: indices
+    int nE = 0, nG = 0;
+    nN = 0;
+    touched = 0;
+    for (int r = 0; r < nr; ++r) {
+      const RowInfo& in = rows_.info(r);
+      const auto ur = static_cast<std::size_t>(r);
+      im.pos[ur] = nN++;
+      im.neg[ur] = in.kind == RowKind::kBilateral ? nN++ : -1;
+      for (int s = 0; s < ns; ++s) touched |= rows_.touches(r, s) ? std::uint64_t{1} << s : 0;
     }
-  }
-  const int nF = nN + nE, n = nF + nG;
-  for (int r = 0, g = 0; r < nr; ++r) im.gam[static_cast<std::size_t>(r)] = rows_.frictionSlot(r) >= 0 ? nF + g++ : -1;
-  im.grow(n);
-  auto M = im.M.topLeftCorner(n, n);
-  auto q = im.q.head(n);
-  M.setZero();
-  q.setZero();
-  // force rows per touched system, Delassus A = Σ_s R_s b_s⁻¹ R_sᵀ = Σ_s X_sᵀ X_s, q = R q̇_free + d/δt
-  int col = 0;
-  for (int s = 0; s < ns; ++s) {
-    if (!((touched >> s) & 1u)) continue;
-    const auto us = static_cast<std::size_t>(s);
-    const Eigen::MatrixXd& J = rows_.jacobians(s);
-    auto R = im.R[us].topRows(nF);
     for (int r = 0; r < nr; ++r) {
       const auto ur = static_cast<std::size_t>(r);
-      R.row(im.pos[ur]) = J.row(r);
-      if (im.neg[ur] >= 0) R.row(im.neg[ur]) = -J.row(r);
-      const int slot = rows_.frictionSlot(r);
-      if (slot < 0) continue;
-      const int m = rows_.info(r).friction_edges;
+      if (rows_.frictionSlot(r) >= 0) {
+        im.edge[ur] = nN + nE;
+        nE += rows_.info(r).friction_edges;
+        ++nG;
+      } else {
+        im.edge[ur] = -1;
+      }
+    }
+    nF = nN + nE;
+    const int n = nF + nG;
+    for (int r = 0, g = 0; r < nr; ++r) im.gam[static_cast<std::size_t>(r)] = rows_.frictionSlot(r) >= 0 ? nF + g++ : -1;
+    im.grow(n);
+    auto M = im.M.topLeftCorner(n, n);
+    auto q = im.q.head(n);
+    M.setZero();
+    q.setZero();
+    // force rows per touched system, Delassus A = Σ_s R_s b_s⁻¹ R_sᵀ = Σ_s X_sᵀ X_s, q = R q̇_free + d/δt
+    col = 0;
+    for (int s = 0; s < ns; ++s) {
+      if (!((touched >> s) & 1u)) continue;
+      const auto us = static_cast<std::size_t>(s);
+      const Eigen::MatrixXd& J = rows_.jacobians(s);
+      auto R = im.R[us].topRows(nF);
+      for (int r = 0; r < nr; ++r) {
+        const auto ur = static_cast<std::size_t>(r);
+        R.row(im.pos[ur]) = J.row(r);
+        if (im.neg[ur] >= 0) R.row(im.neg[ur]) = -J.row(r);
+        const int slot = rows_.frictionSlot(r);
+        if (slot < 0) continue;
+        const int m = rows_.info(r).friction_edges;
+        for (int k = 0; k < m; ++k) {
+          const double th = 2.0 * std::numbers::pi * k / m;
+          R.row(im.edge[ur] + k) = std::cos(th) * rows_.tangents(s, 0).row(slot) + std::sin(th) * rows_.tangents(s, 1).row(slot);
+        }
+      }
+      auto X = im.X[us].leftCols(nF);
+      X = R.transpose();
+      // in panels of kPanel columns: Eigen's blocked kernels then keep their packing buffers on the
+      // stack (under EIGEN_STACK_ALLOCATION_LIMIT) instead of allocating them for large n
+      const auto L = systems_[us]->frictionLLT().matrixL();
+      for (int c0 = 0; c0 < nF; c0 += kPanel) {
+        auto Xc = X.middleCols(c0, std::min(kPanel, nF - c0));
+        L.solveInPlace(Xc);  // L⁻¹ Rᵀ
+      }
+      for (int i0 = 0; i0 < nF; i0 += kPanel) {
+        const int ni = std::min(kPanel, nF - i0);
+        for (int j0 = i0; j0 < nF; j0 += kPanel) {
+          const int nj = std::min(kPanel, nF - j0);
+          M.block(i0, j0, ni, nj).noalias() += X.middleCols(i0, ni).transpose() * X.middleCols(j0, nj);
+          if (j0 != i0) M.block(j0, i0, nj, ni) = M.block(i0, j0, ni, nj).transpose();
+        }
+      }
+      q.head(nF).noalias() += R * systems_[us]->qdotFree();
+      const int nv = static_cast<int>(X.rows());
+      im.A.block(0, col, nN, nv) = X.leftCols(nN).transpose();  // frictionless A = [R_s L_s⁻ᵀ]_s
+      col += nv;
+    }
+    im.q_base.head(n) = q;
+    // the distance terms max(±d/δt, −v_rec) + ±correction/δt of the force rows
+    const auto addDistances = [&] {
+      for (int r = 0; r < nr; ++r) {
+        const RowInfo& in = rows_.info(r);
+        const auto ur = static_cast<std::size_t>(r);
+        const double v = std::isfinite(in.recovery_speed) ? std::max(0.0, in.recovery_speed) : 0.0;
+        const double c = std::isfinite(in.correction) ? in.correction / dt : 0.0;
+        q[im.pos[ur]] += std::max(in.distance / dt, -v) + c;
+        if (im.neg[ur] >= 0) q[im.neg[ur]] += std::max(-in.distance / dt, -v) - c;
+      }
+    };
+    addDistances();
+    for (int r = 0; r < nr; ++r) {
+      const RowInfo& in = rows_.info(r);
+      const auto ur = static_cast<std::size_t>(r);
+      if (im.gam[ur] < 0) continue;
+      // edges: w = t_k q̇ + γ; cone: w_γ = μλ − Σβ
+      const int m = in.friction_edges, g = im.gam[ur], p = im.pos[ur];
+      M(g, p) = in.mu;
       for (int k = 0; k < m; ++k) {
-        const double th = 2.0 * std::numbers::pi * k / m;
-        R.row(im.edge[ur] + k) = std::cos(th) * rows_.tangents(s, 0).row(slot) + std::sin(th) * rows_.tangents(s, 1).row(slot);
+        M(im.edge[ur] + k, g) = 1.0;
+        M(g, im.edge[ur] + k) = -1.0;
       }
     }
-    auto X = im.X[us].leftCols(nF);
-    X = R.transpose();
-    // in panels of kPanel columns: Eigen's blocked kernels then keep their packing buffers on the
-    // stack (under EIGEN_STACK_ALLOCATION_LIMIT) instead of allocating them for large n
-    const auto L = systems_[us]->frictionLLT().matrixL();
-    for (int c0 = 0; c0 < nF; c0 += kPanel) {
-      auto Xc = X.middleCols(c0, std::min(kPanel, nF - c0));
-      L.solveInPlace(Xc);  // L⁻¹ Rᵀ
-    }
-    for (int i0 = 0; i0 < nF; i0 += kPanel) {
-      const int ni = std::min(kPanel, nF - i0);
-      for (int j0 = i0; j0 < nF; j0 += kPanel) {
-        const int nj = std::min(kPanel, nF - j0);
-        M.block(i0, j0, ni, nj).noalias() += X.middleCols(i0, ni).transpose() * X.middleCols(j0, nj);
-        if (j0 != i0) M.block(j0, i0, nj, ni) = M.block(i0, j0, ni, nj).transpose();
-      }
-    }
-    q.head(nF).noalias() += R * systems_[us]->qdotFree();
-    const int nv = static_cast<int>(X.rows());
-    im.A.block(0, col, nN, nv) = X.leftCols(nN).transpose();  // frictionless A = [R_s L_s⁻ᵀ]_s
-    col += nv;
-  }
-  for (int r = 0; r < nr; ++r) {
-    const RowInfo& in = rows_.info(r);
-    const auto ur = static_cast<std::size_t>(r);
-    const double v = std::isfinite(in.recovery_speed) ? std::max(0.0, in.recovery_speed) : 0.0;
-    q[im.pos[ur]] += std::max(in.distance / dt, -v);
-    if (im.neg[ur] >= 0) q[im.neg[ur]] += std::max(-in.distance / dt, -v);
-    if (im.gam[ur] < 0) continue;
-    // edges: w = t_k q̇ + γ; cone: w_γ = μλ − Σβ
-    const int m = in.friction_edges, g = im.gam[ur], p = im.pos[ur];
-    M(g, p) = in.mu;
-    for (int k = 0; k < m; ++k) {
-      M(im.edge[ur] + k, g) = 1.0;
-      M(g, im.edge[ur] + k) = -1.0;
-    }
-  }
-  const auto t2 = Clock::now();
-  rep.assemble_s = seconds(t1, t2);
-  rep.lcp_size = n;
+    t2 = Clock::now();
+    rep.assemble_s = seconds(t1, t2);
+    rep.lcp_size = n;
 
-  // 3. Lemke, then the frictionless problem by the structured solver, then PGS
-  lcp::LcpResult& res = im.result;
-  int nz = 0;  // force rows of the answer
-  const lcp::LcpStatus ls = lcp::solveLemke(M, q, im.lemke, options_.lemke, res);
-  rep.lemke_status = ls;
-  rep.pivots = res.pivots;
-  if (ls == lcp::LcpStatus::Solved && res.z.head(n).allFinite()) {
-    rep.solver = SolverUsed::kLemke;
-    nz = nF;
-  } else {
-    rep.fallback = true;
-    ++failures_;
-    rep.lcp_size = nN;
-    const auto An = im.A.topLeftCorner(nN, col);
-    const auto qn = im.q.head(nN);
-    if (lcp::solveStructured(An, qn, im.structured, options_.structured, res) == lcp::LcpStatus::Solved &&
-        res.z.head(nN).allFinite()) {
-      rep.solver = SolverUsed::kStructured;
-      nz = nN;
-    } else if (lcp::solvePgs(im.M.topLeftCorner(nN, nN), qn, im.pgs, options_.pgs, res) == lcp::LcpStatus::Solved &&
-               res.z.head(nN).allFinite()) {
-      rep.solver = SolverUsed::kPgs;
-      nz = nN;
-    } else {
-      rep.solver = SolverUsed::kFailed;
-      ++unsolved_;
-    }
+    // 3. Lemke, then the frictionless problem by the structured solver, then PGS
+    nz = 0;
+    const lcp::LcpStatus ls = lcp::solveLemke(M, q, im.lemke, options_.lemke, res);
+    rep.lemke_status = ls;
     rep.pivots = res.pivots;
-  }
+    if (ls == lcp::LcpStatus::Solved && res.z.head(n).allFinite()) {
+      rep.solver = SolverUsed::kLemke;
+      nz = nF;
+      // 5. refinement: the producers correct the first-order prediction of their rows with the
+      // velocities of this answer; the LCP is solved again with the same M (only q changes)
+      for (; rounds_left > 0; --rounds_left) {
+        for (int r = 0; r < nr; ++r) {  // λ of the current answer, for the producers
+          const auto ur = static_cast<std::size_t>(r);
+          rows_.info(r).lambda = res.z[im.pos[ur]] - (im.neg[ur] >= 0 ? res.z[im.neg[ur]] : 0.0);
+        }
+        for (int s = 0; s < ns; ++s) {
+          const auto us = static_cast<std::size_t>(s);
+          Eigen::VectorXd& v = im.velocity[us];
+          if ((touched >> s) & 1u) {
+            v.noalias() = im.R[us].topRows(nF).transpose() * res.z.head(nF);
+            systems_[us]->frictionLLT().solveInPlace(v);  // b⁻¹Γ
+            v += systems_[us]->qdotFree();
+          } else {
+            v = systems_[us]->qdotFree();
+          }
+        }
+        bool again = false;
+        for (std::size_t p = 0; p < producers_.size(); ++p)
+          again = producers_[p]->refine(static_cast<int>(p), dt, rows_, im.velocity) || again;
+        if (rows_.size() != nr) {  // late rows: assemble and solve again
+          --rounds_left;
+          ++rep.refine_rounds;
+          assemble = true;
+          break;
+        }
+        if (!again) break;
+        im.z_prev.head(n) = res.z.head(n);
+        q = im.q_base.head(n);
+        addDistances();
+        const lcp::LcpStatus rs = lcp::solveLemke(M, q, im.lemke, options_.lemke, res);
+        ++rep.refine_rounds;
+        rep.pivots = res.pivots;
+        if (rs != lcp::LcpStatus::Solved || !res.z.head(n).allFinite()) {
+          res.z.head(n) = im.z_prev.head(n);  // keep the last good answer
+          break;
+        }
+      }
+    } else {
+      rep.fallback = true;
+      ++failures_;
+      rep.lcp_size = nN;
+      const auto An = im.A.topLeftCorner(nN, col);
+      const auto qn = im.q.head(nN);
+      if (lcp::solveStructured(An, qn, im.structured, options_.structured, res) == lcp::LcpStatus::Solved &&
+          res.z.head(nN).allFinite()) {
+        rep.solver = SolverUsed::kStructured;
+        nz = nN;
+      } else if (lcp::solvePgs(im.M.topLeftCorner(nN, nN), qn, im.pgs, options_.pgs, res) == lcp::LcpStatus::Solved &&
+                 res.z.head(nN).allFinite()) {
+        rep.solver = SolverUsed::kPgs;
+        nz = nN;
+      } else {
+        rep.solver = SolverUsed::kFailed;
+        ++unsolved_;
+      }
+      rep.pivots = res.pivots;
+    }
+  }  // assembly passes
   const auto z = res.z.head(std::max(nz, 0));
 
   // 4. forces back to the systems and the rows

@@ -140,7 +140,8 @@ std::string checkBallLimit(const BallLimit& l) {
   if (cx * cx + cy * cy >= 1.0) return "the swing ellipse must contain the rest direction (swing 0)";
   if (l.maxSwing() > BallLimit::kMaxSwing + 1e-9)
     return "the swing ellipse reaches " + std::to_string(l.maxSwing() * 180 / 3.14159265358979323846) +
-           " deg, past the 170 deg allowed (the swing/twist decomposition is singular at 180 deg)";
+           " deg, past the 150 deg allowed (the swing/twist decomposition is singular at 180 deg and its "
+           "limit rows lose their accuracy well before)";
   if (!(l.twist_lower <= 0 && 0 <= l.twist_upper)) return "the twist range [lower, upper] must contain 0";
   if (l.twist_lower < -BallLimit::kMaxTwist - 1e-9 || l.twist_upper > BallLimit::kMaxTwist + 1e-9)
     return "the twist range must stay within [-170, 170] deg (the twist angle wraps at 180 deg)";

@@ -56,8 +56,18 @@ struct LimitRow {
 ///   columns (ω, body); past kSwingSingular only the radial swing row (the twist is undefined at π);
 /// - ball joint without them: the boxes on its rotation-vector components, J = ±row of Jr(q)⁻¹;
 /// a row is added (unilateral, source kJointLimit / kSwing / kTwist, recovery_speed from the
-/// options) when min(d, d + δt J q̇_free) < activation. The solver's LCP keeps d + δt J q̇ ≥ 0: the
-/// limit holds to first order in δt at the next step. No allocation in addRows()/solved().
+/// options) when min(d, d + δt J q̇_free) < activation; a ball's swing and twist rows come together
+/// (when one is a candidate, all three are added: the twist and the swing direction turn fast at
+/// large swing, so a row far from its limit at q̇_free may still bind after the solve). The
+/// solver's LCP keeps d + δt J q̇ ≥ 0: the limit holds to first order in δt at the next step. The
+/// swing/twist distances are curved along a step (the ellipse, and s, θ_t nonlinear in R; sliding
+/// along the cone at |ω| leaves O(δt²|ω|²/ρ) outside), so refine() gives the solver the rows'
+/// linearisation error at the answer's velocity, c = d(R_k exp(δt ω)) − d − δt J ω (R_k exp(δt ω)
+/// is how the controller integrates a ball), and the LCP is solved again until c settles (within
+/// 1e-9 rad): the limits then hold at q_{k+1} itself, not only to first order. Revolute limits are
+/// linear over a step. refine() also appends late rows: limits without a row that the answer carries
+/// past (the forces at the other rows move them too), with their correction; the solver assembles
+/// again. No allocation in addRows()/refine()/solved().
 class JointLimitRows final : public RowProducer {
  public:
   /// \throws std::invalid_argument on non-finite or negative options or system < 0.
@@ -65,6 +75,7 @@ class JointLimitRows final : public RowProducer {
 
   const char* name() const override { return "joint_limits"; }
   void addRows(int id, double dt, RowSet& rows) override;
+  bool refine(int id, double dt, RowSet& rows, const std::vector<Eigen::VectorXd>& velocity) override;
   void solved(int id, const RowSet& rows) override;
 
   /// Rows of the last step with their λ (after solved()).
@@ -82,14 +93,30 @@ class JointLimitRows final : public RowProducer {
     int q = -1, v = -1, component = -1, ball_q = -1;
     double lower = 0, upper = 0;
   };
-  void add(int id, double dt, RowSet& rows, RowSource source, int coordinate, bool upper, double d,
-           int v, int ncols, const double* jac);
+  struct BallRow {  // a swing/twist row of the step, for refine()
+    int row = -1, joint = -1;
+    int kind = 0;  // 0 swing, 1 twist lower, 2 twist upper
+    bool singular = false;
+    double d = 0, scale = 0;  // d at q_k, κ at q_k
+  };
+  /// Rate of a row under q̇_free; true when min(d, d + δt rate) < activation.
+  bool candidate(double dt, double d, int v, int ncols, const double* jac) const;
+  /// Appends the row (no candidacy test); returns its RowSet index (−1: dropped for capacity).
+  int add(int id, RowSet& rows, RowSource source, int coordinate, bool upper, double d, int v, int ncols,
+          const double* jac, double correction = 0.0);
+  /// Appends box bi's lower or upper row at q_k.
+  void addBox(int id, RowSet& rows, std::size_t bi, bool upper, double correction);
+  /// Appends ball bi's rows at q_k (d: its distances there; correction: 3 values or null).
+  void addBall(int id, RowSet& rows, std::size_t bi, const BallLimitDistances& d, const double* correction);
   const control::Controller* ctl_;
   int system_;
   JointLimitOptions options_;
   std::vector<Box> boxes_;
   std::vector<int> balls_;  // joints with swing/twist limits
   std::vector<LimitRow> rows_;
+  std::vector<BallRow> ball_rows_;
+  std::vector<char> box_rows_;       // 2 per box: its lower/upper row is in the step
+  std::vector<char> ball_has_rows_;  // per ball: its rows are in the step
   double worst_excess_ = 0.0;
 };
 

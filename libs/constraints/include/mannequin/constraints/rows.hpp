@@ -44,6 +44,9 @@ struct RowInfo {
   int tag = -1;             ///< the producer's own index (contact index, coordinate ...)
   double distance = 0.0;    ///< d(q_k): m or rad, < 0 violated (bilateral: the error, target 0)
   double recovery_speed = 1.0;  ///< |d|/δt is capped at this (m/s or rad/s) when d < 0: no jump back
+  /// Linearisation error of the distance over the step (m or rad), set by a producer's refine():
+  /// the LCP keeps max(d/δt, −v_rec) + correction/δt + J q̇ ≥ 0. 0 unless refined.
+  double correction = 0.0;
   double mu = 0.0;          ///< Coulomb coefficient (friction rows only)
   int friction_edges = 0;   ///< m directions of the linearised cone (0: frictionless)
   int system_a = -1, system_b = -1;  ///< systems the row acts on (−1: none, e.g. the static scene)

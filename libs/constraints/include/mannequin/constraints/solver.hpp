@@ -16,9 +16,14 @@
 ///    (the step goes on unconstrained) — never a NaN;
 /// 4. Γ_s = Σ_r R_{r,s}ᵀ z_r goes to each system (q̇_s = q̇_free,s + b_s⁻¹ Γ_s), and every row's λ (and
 ///    friction magnitude) is written back into the RowSet for diagnostics;
-/// 5. (optional) rows that the forces would push past their limit at the next step are checked by the
-///    producers' `late` hook — not used by contacts (their candidates are all pairs within the
-///    activation distance).
+/// 5. refinement (Lemke answers only, at most `refine_rounds` times): with the velocities q̇_s of the
+///    answer, each producer may replace the first-order prediction d + δt J q̇ of its rows by the
+///    distance it really reaches, d(q_k ⊕ δt q̇) — RowProducer::refine() sets RowInfo::correction to
+///    d(q_k ⊕ δt q̇) − d − δt J q̇ (the curvature of the distance along the step) — and the LCP is
+///    solved again with the same matrix (a fixed point: the correction is O(δt²|q̇|²) and its change
+///    between rounds O(δt) smaller). Used by the ball joints' swing/twist rows, whose distances are
+///    curved (joint_limits.hpp); contacts and revolute limits are linear over a step and do not refine.
+///    If a re-solve fails, the previous answer is kept.
 /// Preallocated for capacities given at construction; solve() allocates nothing once the LCP
 /// workspaces have held a problem of the largest size seen (tests/constraints/solver_alloc_test.cpp).
 #include <chrono>
@@ -43,6 +48,13 @@ class RowProducer {
   /// Appends this step's rows (distance at q_k, Jacobians) to `rows`, with info.producer = `id`.
   /// Must not throw or allocate in the loop.
   virtual void addRows(int id, double dt, RowSet& rows) = 0;
+  /// Refinement round (step 5 above): `velocity[s]` is system s's q̇ = q̇_free + b⁻¹Γ of the current
+  /// answer (λ written in `rows`). May set RowInfo::correction of its own rows; returns true when a
+  /// correction changed enough that the LCP must be solved again. Must not throw or allocate.
+  /// Default: nothing (false).
+  virtual bool refine(int /*id*/, double /*dt*/, RowSet& /*rows*/, const std::vector<Eigen::VectorXd>& /*velocity*/) {
+    return false;
+  }
   /// Called after the solve with the rows (λ written); default: nothing.
   virtual void solved(int /*id*/, const RowSet& /*rows*/) {}
 };
@@ -54,6 +66,7 @@ struct SolverOptions {
   int max_rows = 512;           ///< rows of every kind per step
   int max_friction_rows = 256;  ///< rows with a friction cone per step
   int max_edges = 4;            ///< largest friction_edges of a row
+  int refine_rounds = 6;        ///< re-solves for the producers' corrections (step 5; 0: none)
   lcp::LemkeOptions lemke;
   lcp::StructuredOptions structured;
   lcp::PgsOptions pgs;
@@ -66,7 +79,8 @@ struct SolveReport {
   int rows = 0;          ///< rows produced
   int lcp_size = 0;      ///< n of the LCP solved
   int active = 0;        ///< rows with λ > 0
-  int pivots = 0;        ///< Lemke pivots (or the fallback's iterations)
+  int pivots = 0;        ///< Lemke pivots (or the fallback's iterations; the last solve when refined)
+  int refine_rounds = 0; ///< LCP re-solves for the producers' corrections (step 5)
   long dropped = 0;      ///< rows dropped for capacity since construction
   bool fallback = false; ///< Lemke failed and a fallback answered (or nothing did)
   double produce_s = 0, assemble_s = 0, solve_s = 0;  ///< wall time of each stage (s)

@@ -46,7 +46,11 @@ const char* toString(JointType type);
 /// The ellipse must contain s = 0 and stay inside |s| ≤ kMaxSwing (the decomposition is singular
 /// at θ_s = π); checkBallLimit() says what is wrong.
 struct BallLimit {
-  static constexpr double kMaxSwing = 170.0 * 3.14159265358979323846 / 180.0;  ///< rad
+  /// Largest swing on an ellipse (rad). The swing/twist rows' Jacobians grow like θ_s/sin θ_s and
+  /// their curvature like 1/sin²θ_s: at 150° (≤ 5.2×) the constraint layer keeps fast arms inside
+  /// the cone (tests/constraints/joint_limit_rows_test.cpp); at 170° (17×) a step of 0.05 rad turned
+  /// the twist by ~0.5 rad and the swing went into the singular band (issue 13).
+  static constexpr double kMaxSwing = 150.0 * 3.14159265358979323846 / 180.0;
   static constexpr double kMaxTwist = 170.0 * 3.14159265358979323846 / 180.0;  ///< rad
   bool enabled = false;
   Vector3 twist_axis = -Vector3::UnitZ();  ///< t, unit, joint frame
