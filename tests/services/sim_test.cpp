@@ -155,14 +155,14 @@ TEST(SimConfig, ErrorsNameFileLineAndField) {
   expectError("stepper: dynamic\n" + m, "sim.yaml:1: field 'stepper': expected controller or kinematic");
   expectError("joint_limits: {activation: -1}\n" + m, "field 'joint_limits.activation': -1 is outside [0, 1]");
   expectError("target_twist: {max_speed: nan}\n" + m, "field 'target_twist.max_speed': 'nan' is not a finite number");
-  // a missing controller config is named with the mannequin
+  // a missing controller config is named at its entry (paths are resolved when the config is read)
   try {
     simservice::buildMannequins(simservice::parseSimConfig(core::ConfigNode::parse(
         "mannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, controller: configs/control/nope.yaml, "
         "control_frames: {hand_l: hand_l}}\n", "s")));
     ADD_FAILURE() << "no error for a missing controller config";
   } catch (const core::ConfigError& e) {
-    EXPECT_NE(std::string(e.what()).find("mannequin 'a': controller:"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("s:2: field 'mannequins[0].controller'"), std::string::npos) << e.what();
     EXPECT_NE(std::string(e.what()).find("nope.yaml"), std::string::npos) << e.what();
   }
   const auto c = simservice::loadSimConfig("configs/sim/sim_demo.yaml");
@@ -268,7 +268,7 @@ std::vector<std::string> replayOnce(const std::vector<v1::MocapFrame>& frames, c
 }
 
 // A standing actor's 7 bodies at `k`/120 s (capture clock `offset_ns` + k/120 s), `at` the pelvis
-// position: pelvis swaying, hands rising 1.2 m/s for 20 frames, then held.
+// position: pelvis swaying, hands rising 1.2 m/s for 20 frames, then everything held still.
 v1::MocapFrame actorFrame(int k, const math::Vector3& at = math::Vector3::Zero(), std::int64_t offset_ns = 0) {
   v1::MocapFrame f;
   f.mutable_header()->set_stamp_ns(offset_ns + static_cast<std::int64_t>(std::llround(k / 120.0 * 1e9)));
@@ -280,7 +280,7 @@ v1::MocapFrame actorFrame(int k, const math::Vector3& at = math::Vector3::Zero()
     rb->set_name(names[b]);
     rb->set_tracked(true);
     rb->set_quality(1);
-    const math::Vector3 p = at + rel[b] + math::Vector3(0.02 * std::sin(k * 0.3), 0, b >= 3 && b <= 4 ? 0.01 * std::min(k, 20) : 0.0);
+    const math::Vector3 p = at + rel[b] + math::Vector3(0.02 * std::sin(std::min(k, 20) * 0.3), 0, b >= 3 && b <= 4 ? 0.01 * std::min(k, 20) : 0.0);
     transport::toMsg(pose(p), *rb->mutable_pose());
   }
   return f;
@@ -391,7 +391,7 @@ TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {
   const math::Vector3 at_b(3, 0, 0);
   const std::int64_t clock_b = 1'000'000'000'000;
   MocapFeed a{"mocap_a", {}}, b{"mocap_b", {}};
-  for (int k = 0; k < 80; ++k) {  // the hands rise, then hold still for 0.5 s
+  for (int k = 0; k < 80; ++k) {  // the actors move, then hold still for 0.5 s (the last world: both at rest)
     a.frames.push_back(actorFrame(k));
     b.frames.push_back(actorFrame(k, at_b, clock_b));
   }

@@ -141,9 +141,17 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
     e.where = m.where();
     e.field = m.path();
     e.name = m["name"].str();
-    e.config = m["config"].str();
+    e.config = resolvePath(m["config"]);  // from any working directory (findData, else beside the sim config)
     e.root_frame = m.get("root_frame", e.root_frame);
-    e.controller = m.get("controller", e.controller);
+    if (auto ctl = m.find("controller")) {
+      e.controller = resolvePath(*ctl);
+    } else {
+      try {
+        e.controller = core::findData(e.controller);
+      } catch (const core::ConfigError&) {
+        // left as is: buildMannequins names it with the entry when it cannot be read
+      }
+    }
     if (auto src = m.find("mocap_source")) {
       e.mocap_source = src->str();
       bool known = false;
