@@ -14,6 +14,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <algorithm>
 #include <random>
 #include <sstream>
 
@@ -153,10 +154,24 @@ services:
   // tracker gave ~0.1 m (docs/cluster.md). Bound with margin for a loaded machine (live mode).
   EXPECT_LT(mean_hand, 0.05) << "worst " << worst_hand;
   std::printf("hand_l position error over %zu states: mean %.3f m, worst %.3f m\n", worlds.size(), mean_hand, worst_hand);
+  // physics on in configs/sim/sim_demo.yaml (sim.world carries the step diagnostics): the physics'
+  // floor contacts; the soles never deeper in the floor than the segment margin (0.005 m: the contact
+  // rows keep the margin shells from overlapping) and on the floor (≤ 1 cm) in most calibrated worlds
+  EXPECT_TRUE(last.has_diagnostics()) << "configs/sim/sim_demo.yaml should run with physics on";
   bool contacts_seen = false;
-  for (const auto& w : worlds) contacts_seen = contacts_seen || w.mannequins(0).contacts_size() > 0;
-  // only that collision reported contacts (the sole height against the floor is not checked here)
-  EXPECT_TRUE(contacts_seen) << "no sim.world carried contacts from the collision service";
+  std::size_t calibrated = 0, on_floor = 0;
+  double lowest = 1e9;
+  for (const auto& w : worlds) {
+    contacts_seen = contacts_seen || w.mannequins(0).contacts_size() > 0;
+    if (!w.mannequins(0).calibrated()) continue;
+    ++calibrated;
+    const double sole = w.mannequins(0).sole_height();
+    EXPECT_GE(sole, -0.005) << "sim.world at step " << w.step() << ": sole below the floor by more than the segment margin";
+    lowest = std::min(lowest, sole);
+    on_floor += sole <= 0.01;
+  }
+  EXPECT_TRUE(contacts_seen) << "no sim.world carried floor contacts";
+  EXPECT_GT(on_floor, calibrated / 2) << "calibrated worlds with a sole within 1 cm of the floor; lowest sole " << lowest << " m";
 
   // summary: every service heartbeated, stopped cleanly; garbage counted as malformed
   const std::string json = readFile(summary);

@@ -72,7 +72,7 @@ class ReplayRegression : public ::testing::Test {
     dir_ = tempPath("regression");
     fs::remove_all(dir_);
     fs::create_directories(dir_);
-    // the shipped demo sim config, in replay (deterministic) mode. sim.world at
+    // the shipped demo sim config (physics on, as in configs/sim/sim_demo.yaml), in replay (deterministic) mode. sim.world at
     // 60 Hz of simulation time only: publish_on_mocap would make the number of worlds depend on how
     // the frames are batched on arrival (143 worlds for 315 frames replayed --fast, 366 in lockstep)
     spit(dir_ / "sim.yaml", R"(name: sim
@@ -88,6 +88,8 @@ calibration: {needs_flag: false}
 stepper: controller
 collision: )" + std::string(collision_ ? "{mode: service, period_steps: 10, replay_deadline: 5.0, margin: 0.02}"
                                                   : "{mode: none}") + R"(
+physics: {enabled: true, gravity: [0, 0, -9.81], scene: configs/scenes/floor.yaml, segment_margin: 0.005, segment_material: skin, query_period_steps: 1,
+          activation_distance: 0.02, calibration_clearance: 0.002, friction_edges: 4, recovery_speed: 0.5, max_rows: 512}
 mannequins:
   - name: operator
     config: configs/mannequins/male_50th.yaml
@@ -285,8 +287,11 @@ void ReplayRegression::run() {
   }
   EXPECT_EQ(differing, 0U) << "first differing sim.world: #" << first << " of " << want.size() << detail;
 
-  // the worlds are real: calibrated mannequin, contacts with the floor in time (never stale)
-  std::size_t calibrated = 0, with_contacts = 0, stale = 0;
+  // the worlds are real: calibrated mannequin, contacts with the floor in time (never stale), the
+  // soles never deeper in the floor than the segment margin (0.005 m: the contact rows keep the margin
+  // shells from overlapping) and on the floor (≤ 1 cm) in most worlds
+  std::size_t calibrated = 0, with_contacts = 0, stale = 0, on_floor = 0;
+  double lowest = 1e9;
   for (const Message& m : want) {
     mannequin::v1::WorldState w;
     ASSERT_TRUE(w.ParseFromString(m.data));
@@ -296,11 +301,17 @@ void ReplayRegression::run() {
     calibrated += w.mannequins(0).calibrated();
     with_contacts += w.mannequins(0).contacts_size() > 0;
     stale += w.contacts_stale();
+    const double sole = w.mannequins(0).sole_height();  // NaN with the physics off: fails below
+    EXPECT_GE(sole, -0.005) << "sim.world at step " << w.step() << ": sole below the floor by more than the segment margin";
+    lowest = std::min(lowest, sole);
+    on_floor += sole <= 0.01;
   }
   EXPECT_GT(calibrated, want.size() / 2);
+  EXPECT_GT(on_floor, want.size() / 2) << "worlds with a sole within 1 cm of the floor; lowest sole " << lowest << " m";
+  // the physics' floor contacts in most worlds (with collision on, the service's contacts are queried
+  // in lockstep too — never stale — but sim.world carries the physics' own)
+  EXPECT_GT(with_contacts, want.size() / 2) << "worlds with contacts reported";
   if (collision_) {
-    // only that collision reported contacts in most worlds (the sole height against the floor is not checked here)
-    EXPECT_GT(with_contacts, want.size() / 2) << "worlds with contacts reported";
     EXPECT_EQ(stale, 0U);
   }
 }

@@ -105,6 +105,43 @@ TEST(SimulateTool, BadConfigNamesFileAndLineAndExitsTwo) {
   fs::remove(scene);
 }
 
+TEST(SimulateTool, BadMannequinMocapAndCaptureFilesNameFileAndLineAndExitTwo) {
+  // a mannequin config with a typo on line 3
+  const fs::path mannequin = temp("bad_mannequin.yaml");
+  std::ofstream(mannequin) << "name: m\nstature_m: 1.75\nmass_kgg: 70\n";
+  const ToolRun m = run("--mannequin " + mannequin.string() + " --duration 0.01 --json");
+  EXPECT_EQ(m.status, 2) << m.err;
+  EXPECT_NE(m.err.find(mannequin.string() + ":3"), std::string::npos) << m.err;
+  EXPECT_NE(m.err.find("mass_kgg"), std::string::npos) << m.err;
+  EXPECT_TRUE(m.out.empty()) << m.out;
+
+  // a sim config whose `mocap` config (line 4 of the sim config names it) has a bad value on line 4
+  const fs::path mocap = temp("bad_mocap.yaml");
+  std::ofstream(mocap) << "name: mocap\nsource: bvh\nbvh:\n  rate: -2\n  file: data/bvh/cmu_max_131_03.bvh\n"
+                          "  map: configs/mappings/cmu.yaml\n  bodies: [pelvis]\n";
+  const fs::path cfg = temp("mocap_cfg.yaml");
+  std::ofstream(cfg) << "name: sim\nstep: 0.001\nphysics: {enabled: true, scene: configs/scenes/floor.yaml}\nmocap: " << mocap.string()
+                     << "\nmannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, control_frames: {pelvis: pelvis}}\n";
+  const ToolRun c = run("--config " + cfg.string() + " --duration 0.01 --json");
+  EXPECT_EQ(c.status, 2) << c.err;
+  EXPECT_NE(c.err.find(mocap.string() + ":4"), std::string::npos) << c.err;
+  EXPECT_NE(c.err.find("rate"), std::string::npos) << c.err;
+  // a mocap config that is not a BVH capture: the line of its `source`
+  std::ofstream(mocap) << "name: mocap\n\nsource: synthetic\nsynthetic: {rate_hz: 120}\n";
+  const ToolRun k = run("--config " + cfg.string() + " --duration 0.01 --json");
+  EXPECT_EQ(k.status, 2) << k.err;
+  EXPECT_NE(k.err.find(mocap.string() + ":3"), std::string::npos) << k.err;
+
+  // a broken BVH capture (--mocap): the BVH file's own line
+  const fs::path bvh = temp("bad.bvh");
+  std::ofstream(bvh) << "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n";
+  const ToolRun b = run("--mocap " + bvh.string() + " --duration 0.01 --json");
+  EXPECT_EQ(b.status, 2) << b.err;
+  EXPECT_NE(b.err.find(bvh.string() + ":"), std::string::npos) << b.err;
+  EXPECT_TRUE(b.out.empty()) << b.out;
+  for (const fs::path& p : {mannequin, mocap, cfg, bvh}) fs::remove(p);
+}
+
 TEST(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {
   const ToolRun a = run("--config configs/sim/sim_demo.yaml --duration 1 --json");
   ASSERT_EQ(a.status, 0) << a.err;
@@ -113,10 +150,7 @@ TEST(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {
   EXPECT_EQ(a.out.front(), '{') << a.out;
   EXPECT_EQ(a.out.find('{', 1), std::string::npos) << a.out;
   EXPECT_EQ(a.out.substr(a.out.find('}')), "}\n") << a.out;
-  for (const char* k : kKeys) {
-    // the balance distance exists only while a support is known (World::mannequinDiagnostics): null otherwise
-    if (std::string(k) == "min_balance_distance_m" && a.out.find("\"min_balance_distance_m\": null") != std::string::npos)
-      continue;
+  for (const char* k : kKeys) {  // min_balance_distance_m included: the feet's floor contacts give a support
     const auto v = number(a.out, k);
     ASSERT_TRUE(v.has_value()) << k << " missing or not a number in " << a.out;
     EXPECT_TRUE(std::isfinite(*v)) << k;
@@ -138,6 +172,12 @@ TEST(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {
   EXPECT_LT(*number(a.out, "mean_hand_error_m"), 0.05) << a.out;
   EXPECT_LT(*number(a.out, "mean_foot_error_m"), 0.05) << a.out;
   EXPECT_LT(*number(a.out, "worst_joint_limit_excess_rad"), 0.1) << a.out;
+  // the signed distance of the CoM projection to the support boundary (3.22): a CoM over two feet is at
+  // most half the feet's span (< 0.2 m) inside it, and the first second (standing, then the first
+  // steps of the walk) never takes it as far as 0.3 m outside
+  const double balance = *number(a.out, "min_balance_distance_m");
+  EXPECT_LT(balance, 0.2) << a.out;
+  EXPECT_GT(balance, -0.3) << a.out;
 
   const ToolRun b = run("--config configs/sim/sim_demo.yaml --duration 1 --json");
   ASSERT_EQ(b.status, 0) << b.err;
@@ -182,5 +222,32 @@ TEST(SimulateTool, OutFileHoldsSimWorldMessagesAtTheWorldRate) {
   }
   EXPECT_GT(with_foot_contact, 15) << "the demo starts standing";
   EXPECT_GT(floor_contacts, 0);
+  fs::remove(mcap);
+}
+
+TEST(SimulateTool, OutFileCarriesTheSceneObjects) {
+  // configs/scenes/table.yaml: the ball and the tray (movable, with a mass) rest on the table top
+  // (z = 0.75 m); every sim.world carries them where the scene put them
+  const fs::path mcap = temp("objects.mcap");
+  const ToolRun r = run("--config configs/sim/sim_demo.yaml --scene configs/scenes/table.yaml --duration 0.3 --out " + mcap.string());
+  ASSERT_EQ(r.status, 0) << r.err;
+  const auto messages = mannequin::recording::McapReader::open(mcap.string()).readAll();
+  ASSERT_EQ(messages.size(), 18u);  // 0.3 s at 60 Hz
+  for (const auto& m : messages) {
+    mannequin::v1::WorldState w;
+    ASSERT_TRUE(w.ParseFromString(m.data));
+    ASSERT_EQ(w.objects_size(), 2) << w.ShortDebugString().substr(0, 500);
+    for (const auto& o : w.objects()) {
+      // ball centre = top + radius; tray centre = top + its 2 mm margin + half its 5 mm bottom; within the
+      // contact layer's mm penetration tolerance, nothing sliding
+      const bool ball = o.name() == "ball";
+      ASSERT_TRUE(ball || o.name() == "tray") << o.name();
+      const double x = ball ? 0.9 : 1.15, y = ball ? 0.2 : -0.15, z = ball ? 0.75 + 0.11 : 0.75 + 0.002 + 0.0025;
+      EXPECT_NEAR(o.pose().position().z(), z, 2e-3) << o.name() << " at step " << w.step();
+      EXPECT_NEAR(o.pose().position().x(), x, 1e-3) << o.name();
+      EXPECT_NEAR(o.pose().position().y(), y, 1e-3) << o.name();
+      EXPECT_LT(std::hypot(o.velocity().x(), o.velocity().y(), o.velocity().z()), 0.01) << o.name();
+    }
+  }
   fs::remove(mcap);
 }

@@ -14,6 +14,7 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/core/main.hpp"
@@ -188,8 +189,12 @@ Setup load(const std::string& config_path, const std::string& mocap_bvh, const s
   } catch (const YAML::Exception& e) {
     throw core::ConfigError(fmt::format("{}:{}: {}", mocap_path, e.mark.line + 1, e.msg));
   }
-  if (!raw["source"] || raw["source"].as<std::string>() != "bvh" || !raw["bvh"])
-    throw core::ConfigError(mocap_path + ": mannequin-simulate plays BVH captures (source: bvh with a bvh section)");
+  if (!raw.IsMap()) throw core::ConfigError(mocap_path + ":1: a mocap config (a map with `source: bvh` and a `bvh` section)");
+  if (!raw["source"] || raw["source"].as<std::string>("") != "bvh" || !raw["bvh"]) {
+    const YAML::Mark at = raw["source"] ? raw["source"].Mark() : raw.Mark();
+    throw core::ConfigError(fmt::format("{}:{}: field 'source': mannequin-simulate plays BVH captures (source: bvh with a bvh section)",
+                                        mocap_path, at.line + 1));
+  }
   if (!mocap_bvh.empty()) raw["bvh"]["file"] = mocap_bvh;
   raw["bvh"]["loop"] = false;   // the capture once
   raw["bvh"]["paced"] = false;  // as fast as asked for
@@ -263,14 +268,18 @@ int main(int argc, char** argv) {
     Progress progress(::isatty(STDERR_FILENO) == 1, std::isfinite(total) ? total : setup.capture_length_s);
     const auto t0 = std::chrono::steady_clock::now();
     const auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+    const std::vector<std::string> sources = world.mocapSources();  // "" first
     bool done = false;
     while (!done && !setup.source->finished()) {
       const std::optional<mocap::Frame> f = setup.source->next(std::chrono::microseconds(0));
       if (!f) continue;
       ++s.frames;
-      world.addMocap(*f);
-      if (!world.anchored()) world.anchor(f->stamp_ns);
-      while (world.captureTimeNs() + step_ns <= f->stamp_ns) {
+      // the one capture drives every mocap source the mannequins name (sim config `mocap_sources`)
+      for (const std::string& src : sources) {
+        world.addMocap(*f, src);
+        if (!world.anchored(src)) world.anchor(f->stamp_ns, src);
+      }
+      while (world.captureTimeNs(sources.front()) + step_ns <= f->stamp_ns) {
         if (world.time() + 0.5 * config.world.step >= total) {
           done = true;
           break;

@@ -57,7 +57,7 @@ void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
 SimServiceConfig parseSimConfig(const ConfigNode& root) {
   root.allowOnly({"name", "publish", "connect", "mode", "step", "world_rate", "publish_on_mocap", "interpolation_delay",
                   "reanchor_threshold", "occlusion", "calibration", "gains", "collision", "mannequins", "stepper",
-                  "target_twist", "joint_limits", "physics", "mocap"});
+                  "target_twist", "joint_limits", "physics", "mocap", "mocap_sources", "status_period"});
   SimServiceConfig c;
   c.name = root.get("name", c.name);
   if (auto p = root.find("publish")) c.publish = p->strings();
@@ -123,15 +123,47 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
   }
   if (auto ph = root.find("physics")) parsePhysics(*ph, c.world.physics);
   if (auto mo = root.find("mocap")) c.mocap = resolvePath(*mo);
+  c.status_period = root.getIn("status_period", c.status_period, 0.0, 3600.0);
+  if (auto ms = root.find("mocap_sources"))
+    for (const ConfigNode& s : ms->items()) {
+      s.allowOnly({"name", "connect"});
+      MocapSourceEntry e;
+      e.name = s["name"].str();
+      if (e.name.empty()) s["name"].fail("must not be empty (the mocap service's name, Header.source of its frames)");
+      for (const MocapSourceEntry& o : c.mocap_sources)
+        if (o.name == e.name) s["name"].fail("mocap source '" + e.name + "' listed twice");
+      if (auto cn = s.find("connect")) e.connect = cn->strings();
+      c.mocap_sources.push_back(e);
+    }
   for (const ConfigNode& m : root["mannequins"].items()) {
-    m.allowOnly({"name", "config", "root_frame", "control_frames", "controller"});
+    m.allowOnly({"name", "config", "root_frame", "control_frames", "controller", "mocap_source"});
     MannequinEntry e;
     e.where = m.where();
     e.field = m.path();
     e.name = m["name"].str();
-    e.config = m["config"].str();
+    e.config = resolvePath(m["config"]);  // from any working directory (findData, else beside the sim config)
     e.root_frame = m.get("root_frame", e.root_frame);
-    e.controller = m.get("controller", e.controller);
+    if (auto ctl = m.find("controller")) {
+      e.controller = resolvePath(*ctl);
+    } else {
+      try {
+        e.controller = core::findData(e.controller);
+      } catch (const core::ConfigError&) {
+        // left as is: buildMannequins names it with the entry when it cannot be read
+      }
+    }
+    if (auto src = m.find("mocap_source")) {
+      e.mocap_source = src->str();
+      bool known = false;
+      std::string list;
+      for (const MocapSourceEntry& o : c.mocap_sources) {
+        known = known || o.name == e.mocap_source;
+        list += (list.empty() ? "" : ", ") + o.name;
+      }
+      if (!known)
+        src->fail("unknown mocap source '" + e.mocap_source + "' (" +
+                  (list.empty() ? std::string("no mocap_sources listed") : "mocap_sources: " + list) + ")");
+    }
     const ConfigNode frames = m["control_frames"];
     for (const std::string& f : frames.keys()) e.frames.push_back({f, frames[f].str()});
     if (e.frames.empty()) frames.fail("no control frame");
@@ -160,6 +192,7 @@ std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config)
     }
     s.frames = e.frames;
     s.root_frame = e.root_frame;
+    s.mocap_source = e.mocap_source;
     for (const auto& f : e.frames)
       if (s.model.findFrame(f.frame) < 0) {
         std::string list;

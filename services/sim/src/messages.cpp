@@ -66,12 +66,28 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
   if (contacts != nullptr) out.set_contacts_step(contacts->step());
   const collision::CollisionWorld* cw = world.physics() ? world.collisionWorld() : nullptr;
   if (cw != nullptr) toDiagnostics(world.diagnostics(), replay, *out.mutable_diagnostics());
-  if (const mocap::Frame* m = world.latestMocap()) {
-    v1::FrameRef* r = out.mutable_mocap();
-    r->set_sequence(m->sequence);
-    r->set_stamp_ns(m->stamp_ns);
-    r->set_send_time_ns(m->send_time_ns);
-    r->set_frame_number(m->frame_number);
+  const auto frameRef = [](const mocap::Frame& m, const std::string& source, v1::FrameRef& r) {
+    r.set_sequence(m.sequence);
+    r.set_stamp_ns(m.stamp_ns);
+    r.set_send_time_ns(m.send_time_ns);
+    r.set_frame_number(m.frame_number);
+    r.set_source(source);
+  };
+  const std::vector<std::string> sources = world.mocapSources();
+  for (const std::string& src : sources)
+    if (const mocap::Frame* m = world.latestMocap(src)) {
+      frameRef(*m, src, *out.add_mocap_sources());
+      if (!out.has_mocap()) frameRef(*m, src, *out.mutable_mocap());
+    }
+  for (int i = 0; i < world.numObjects(); ++i) {
+    const sim::RigidObject& o = world.object(i);
+    v1::ObjectState* os = out.add_objects();
+    os->set_name(o.name());
+    toMsg(o.pose(), *os->mutable_pose());
+    for (Eigen::Index k = 0; k < o.velocity().size(); ++k) os->add_twist(o.velocity()(k));
+    os->set_hinged(o.hinged());
+    os->set_angle(o.angle());
+    toMsg3(o.pointVelocity(o.pose().p), *os->mutable_velocity());
   }
   for (int i = 0; i < world.numMannequins(); ++i) {
     const skeleton::Model& model = world.model(i);

@@ -4,6 +4,7 @@
 #include <spdlog/spdlog.h>
 
 #include <cmath>
+#include <algorithm>
 #include <deque>
 
 #include "mannequin/service/runtime.hpp"
@@ -26,6 +27,25 @@ struct SimService::Impl {
   transport::HealthReporter health;
   SimStats stats;
   std::deque<v1::MocapFrame> pending;  // replay: frames not yet stepped to
+  std::vector<std::string> world_sources;  // World::mocapSources(): the sources some mannequin uses ("" first)
+  std::uint64_t unused_source_frames = 0;  // frames of a listed source no mannequin uses
+  // Status line and stop summary (physics on): contacts, penetration, balance; the per-mannequin
+  // vectors are sized at construction (nothing allocated per step).
+  struct Totals {
+    int max_contacts = 0;
+    double contact_sum = 0, max_penetration_m = 0;
+    std::uint64_t steps = 0;
+    std::vector<double> min_balance;  // per mannequin; NaN: no support in the period
+    void reset(int mannequins) {
+      max_contacts = 0;
+      contact_sum = 0;
+      max_penetration_m = 0;
+      steps = 0;
+      min_balance.assign(static_cast<std::size_t>(mannequins), std::nan(""));
+    }
+  };
+  Totals period, run_totals;
+  std::int64_t last_status_ns = 0;
   bool new_mocap = false;
   std::int64_t step_ns;
   double world_phase = 0.0;  // fraction of a sim.world period accumulated (exact average rate)
@@ -43,8 +63,11 @@ struct SimService::Impl {
       : config(c),
         world(buildMannequins(c), c.world),
         pub(ctx, transport::PublisherOptions{c.name, c.publish, 1000, c.mode == Mode::kReplay}),
-        sub(ctx, transport::SubscriberOptions{c.name, c.connect, c.mode == Mode::kReplay ? 100000 : 1000, 10000}),
+        sub(ctx, transport::SubscriberOptions{c.name, subscriberEndpoints(c), c.mode == Mode::kReplay ? 100000 : 1000, 10000}),
         health(pub, c.name, &sub, hb) {
+    world_sources = world.mocapSources();
+    period.reset(world.numMannequins());
+    run_totals.reset(world.numMannequins());
     step_ns = static_cast<std::int64_t>(std::llround(c.world.step * 1e9));
     sub.subscribe(topics::kMocapFrame, std::function<void(const v1::MocapFrame&)>([this](const v1::MocapFrame& f) { onMocap(f); }),
                   transport::validateMocapFrame);
@@ -53,24 +76,98 @@ struct SimService::Impl {
                   transport::validateContactSet);
   }
 
+  static std::vector<std::string> subscriberEndpoints(const SimServiceConfig& c) {
+    std::vector<std::string> out = c.connect;
+    for (const MocapSourceEntry& e : c.mocap_sources)
+      for (const std::string& ep : e.connect)
+        if (std::find(out.begin(), out.end(), ep) == out.end()) out.push_back(ep);
+    return out;
+  }
+
+  // The World source of a frame: the `mocap_sources` entry named like its publisher (Header.source),
+  // else the default source "". nullptr when no mannequin uses that source (the frame is dropped).
+  const std::string* sourceOf(const v1::MocapFrame& f) const {
+    static const std::string kDefault;
+    const std::string* name = &kDefault;
+    for (const MocapSourceEntry& e : config.mocap_sources)
+      if (e.name == f.header().source()) name = &e.name;
+    for (const std::string& w : world_sources)
+      if (w == *name) return name;
+    return nullptr;
+  }
+
   void onMocap(const v1::MocapFrame& f) {
     ++stats.mocap_frames;
+    const std::string* src = sourceOf(f);
+    if (src == nullptr) {
+      ++unused_source_frames;
+      return;
+    }
     if (config.mode == Mode::kReplay) {
       pending.push_back(f);
       return;
     }
     const mocap::Frame in = transport::fromMsg(f);
-    world.addMocap(in);
+    world.addMocap(in, *src);
     new_mocap = true;
-    if (!world.anchored()) {
-      world.anchor(in.stamp_ns);
+    if (!world.anchored(*src)) {
+      world.anchor(in.stamp_ns, *src);
     } else {
-      const double drift = static_cast<double>(in.stamp_ns - world.captureTimeNs()) * 1e-9 - config.world.interpolation_delay;
+      const double drift = static_cast<double>(in.stamp_ns - world.captureTimeNs(*src)) * 1e-9 - config.world.interpolation_delay;
       if (std::abs(drift) > config.reanchor_threshold) {
-        spdlog::info("{}: capture clock {} by {:.3f} s: re-anchored", config.name, drift > 0 ? "ahead" : "behind", std::abs(drift));
-        world.anchor(in.stamp_ns);
+        spdlog::info("{}: capture clock{} {} by {:.3f} s: re-anchored", config.name, src->empty() ? "" : " of " + *src,
+                     drift > 0 ? "ahead" : "behind", std::abs(drift));
+        world.anchor(in.stamp_ns, *src);
       }
     }
+  }
+
+  // After each step (physics on): the totals of the status period and of the run.
+  void accumulate() {
+    if (!world.physics()) return;
+    const sim::StepDiagnostics& d = world.diagnostics();
+    for (Totals* t : {&period, &run_totals}) {
+      ++t->steps;
+      t->max_contacts = std::max(t->max_contacts, d.contacts);
+      t->contact_sum += d.contacts;
+      t->max_penetration_m = std::max(t->max_penetration_m, d.max_penetration_m);
+      for (int m = 0; m < world.numMannequins(); ++m) {
+        const double b = world.mannequinDiagnostics(m).balance_distance_m;
+        double& mb = t->min_balance[static_cast<std::size_t>(m)];
+        if (std::isfinite(b) && !(b >= mb)) mb = b;  // NaN mb: the first finite value
+      }
+    }
+  }
+
+  // "contacts 6 (mean 5.8, max 8), max penetration 1.23 mm, balance operator 0.043 m (min 0.012 m)".
+  std::string physicsLine(const Totals& t, bool current) const {
+    if (!world.physics()) return "physics off";
+    const sim::StepDiagnostics& d = world.diagnostics();
+    std::string line = current ? fmt::format("contacts {} (mean {:.1f}, max {})", d.contacts,
+                                             t.steps > 0 ? t.contact_sum / static_cast<double>(t.steps) : 0.0, t.max_contacts)
+                               : fmt::format("contacts mean {:.1f}, max {}",
+                                             t.steps > 0 ? t.contact_sum / static_cast<double>(t.steps) : 0.0, t.max_contacts);
+    line += fmt::format(", max penetration {:.2f} mm, balance", t.max_penetration_m * 1e3);
+    const auto dist = [](double v) { return std::isfinite(v) ? fmt::format("{:.3f} m", v) : std::string("none"); };
+    for (int m = 0; m < world.numMannequins(); ++m) {
+      line += fmt::format("{} {} ", m > 0 ? "," : "", world.name(m));
+      const double minb = t.min_balance[static_cast<std::size_t>(m)];
+      if (current)
+        line += fmt::format("{} (min {})", dist(world.mannequinDiagnostics(m).balance_distance_m), dist(minb));
+      else
+        line += fmt::format("min {}", dist(minb));
+    }
+    return line;
+  }
+
+  void statusLine() {
+    if (config.status_period <= 0) return;
+    const std::int64_t now = transport::steadyNs();
+    if (now - last_status_ns < static_cast<std::int64_t>(config.status_period * 1e9)) return;
+    last_status_ns = now;
+    spdlog::info("{}: t {:.3f} s, {} steps, {} sim.world, {} mocap frames | {}", config.name, world.time(), stats.steps,
+                 stats.worlds, stats.mocap_frames, physicsLine(period, true));
+    period.reset(world.numMannequins());
   }
 
   void onContacts(const v1::ContactSet& s) {
@@ -120,6 +217,7 @@ struct SimService::Impl {
     collisionBeforeStep(stop);
     world.step();
     ++stats.steps;
+    accumulate();
     health.loopIteration();
     world_phase += config.world_rate * config.world.step;
     const bool scheduled = world_phase >= 1.0 - 1e-9;
@@ -166,6 +264,17 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
                s.config.world_rate, s.world.numMannequins(),
                s.config.stepper == StepperKind::kController ? "controller" : "kinematic tracker", fmt::join(s.pub.boundEndpoints(), ", "),
                fmt::join(s.config.connect, ", "));
+  if (!s.config.mocap_sources.empty()) {
+    std::string list;
+    for (const MocapSourceEntry& e : s.config.mocap_sources) {
+      int users = 0;
+      for (const MannequinEntry& m : s.config.mannequins) users += m.mocap_source == e.name;
+      list += fmt::format("{}{} ({} mannequin(s){}{})", list.empty() ? "" : ", ", e.name, users, e.connect.empty() ? "" : ", ",
+                          fmt::join(e.connect, ", "));
+    }
+    spdlog::info("{}: mocap sources (by the publisher's name): {}", s.config.name, list);
+  }
+  s.last_status_ns = transport::steadyNs();
   std::int64_t next = transport::steadyNs();
   service::ServiceLoop(s.health, stop, duration)
       .run(
@@ -174,12 +283,13 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
             if (s.config.mode == Mode::kReplay) {
               s.sub.poll(milliseconds(20));
               while (!s.pending.empty() && !stop.load()) {
+                const std::string& src = *s.sourceOf(s.pending.front());  // pending holds frames of used sources only
                 const mocap::Frame in = transport::fromMsg(s.pending.front());
                 s.pending.pop_front();
-                s.world.addMocap(in);
+                s.world.addMocap(in, src);
                 s.new_mocap = true;
-                if (!s.world.anchored()) s.world.anchor(in.stamp_ns);
-                while (s.world.captureTimeNs() + s.step_ns <= in.stamp_ns && !stop.load()) s.stepOnce(stop);
+                if (!s.world.anchored(src)) s.world.anchor(in.stamp_ns, src);
+                while (s.world.captureTimeNs(src) + s.step_ns <= in.stamp_ns && !stop.load()) s.stepOnce(stop);
               }
             } else {
               const std::int64_t now = transport::steadyNs();
@@ -198,11 +308,14 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
               }
             }
             if (s.stats.steps % 64 == 0) s.updateHealth();
+            s.statusLine();
             return true;
           },
           {}, [&] { s.updateHealth(); });
-  spdlog::info("{}: stopped after {} steps ({:.3f} s simulated), {} mocap frames, {} sim.world", s.config.name, s.stats.steps,
-               s.world.time(), s.stats.mocap_frames, s.stats.worlds);
+  spdlog::info("{}: stopped after {} steps ({:.3f} s simulated), {} mocap frames, {} sim.world | {}", s.config.name,
+               s.stats.steps, s.world.time(), s.stats.mocap_frames, s.stats.worlds, s.physicsLine(s.run_totals, false));
+  if (s.unused_source_frames > 0)
+    spdlog::warn("{}: {} mocap frames of a source no mannequin uses were dropped", s.config.name, s.unused_source_frames);
   return 0;
 }
 

@@ -26,8 +26,19 @@ struct MannequinEntry {
   std::string root_frame = "pelvis";
   std::vector<sim::ControlFrameSpec> frames;
   std::string controller = "configs/control/mocap.yaml";  ///< stepper: controller
+  /// Key `mocap_source`: the name of a `mocap_sources` entry whose frames drive this mannequin; "" (absent):
+  /// the default source (frames of any publisher not listed in `mocap_sources`).
+  std::string mocap_source;
   std::string where;         ///< "FILE:LINE" of its entry in the sim config ("" if not read from a file)
   std::string field;         ///< its path there ("mannequins[0]"), for errors found by buildMannequins
+};
+
+/// Key `mocap_sources` entry: a mocap service whose frames form their own source (one actor, one
+/// capture system: its own buffer and clock anchor in the World). A frame belongs to the entry whose
+/// `name` equals its Header.source (the publishing service's name, `--name`).
+struct MocapSourceEntry {
+  std::string name;                  ///< the mocap service's name (Header.source of its frames)
+  std::vector<std::string> connect;  ///< its publisher endpoints (added to the subscriber's; may be empty)
 };
 
 /// What steps the mannequins: the control library's Controller (default) or the KinematicTracker.
@@ -43,6 +54,8 @@ struct SimServiceConfig {
   sim::SimConfig world;
   StepperKind stepper = StepperKind::kController;
   std::vector<MannequinEntry> mannequins;
+  std::vector<MocapSourceEntry> mocap_sources;  ///< key `mocap_sources` (empty: one default source)
+  double status_period = 5.0;  ///< s of wall time between status lines (contacts, penetration, balance); 0: none
   CollisionSettings collision;
   /// Key `mocap`: the mocap config (configs/sim/mocap_*.yaml, its `source` section) mannequin-simulate
   /// reads the capture from when run offline; found with core::findData, else beside the sim config.
