@@ -408,6 +408,11 @@ bool World::release(int handle) {
   return true;
 }
 
+bool World::objectHeld(int i) const {
+  (void)object(i);
+  return physics_->grasps && physics_->grasps->held(i);
+}
+
 math::Vector3 World::graspForce(int handle) const {
   if (!physics_ || !physics_->grasps || handle < 0 || static_cast<std::size_t>(handle) >= physics_->grasp_records.size() ||
       physics_->grasp_records[static_cast<std::size_t>(handle)].object < 0)

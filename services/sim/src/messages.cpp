@@ -88,6 +88,7 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
     os->set_hinged(o.hinged());
     os->set_angle(o.angle());
     toMsg3(o.pointVelocity(o.pose().p), *os->mutable_velocity());
+    os->set_held(world.objectHeld(i));
   }
   for (int i = 0; i < world.numMannequins(); ++i) {
     const skeleton::Model& model = world.model(i);

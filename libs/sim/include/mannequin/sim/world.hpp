@@ -230,6 +230,8 @@ class World {
   int grasp(int m, const std::string& frame, const std::string& object);
   /// Releases a grasp; false for an unknown handle.
   bool release(int handle);
+  /// Whether a hand holds object i.
+  bool objectHeld(int i) const;
   /// Force (N, world) the grasp `handle` applied on its object at the last step (the hand gets the
   /// opposite); zero for an unknown handle.
   math::Vector3 graspForce(int handle) const;
