@@ -249,7 +249,7 @@ const SolveReport& ConstraintSolver::solve(double dt) {
   for (int s = 0; s < ns; ++s) {
     if (!((touched >> s) & 1u)) continue;
     const auto us = static_cast<std::size_t>(s);
-    const Eigen::MatrixXd& J = rows_.jacobians(s);
+    const RowSet::RowMatrix& J = rows_.jacobians(s);
     auto Rt = im.Rt[us].leftCols(nF);
     for (int r = 0; r < nr; ++r) {
       const auto ur = static_cast<std::size_t>(r);
