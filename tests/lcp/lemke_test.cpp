@@ -394,3 +394,43 @@ TEST(Lemke, ProductFormAgreesWithDenseTableau) {
   }
   EXPECT_GE(compared, 30);
 }
+
+// M given as an operator (M = A Aᵀ, never formed: columns A (Aᵀ e_j), products A (Aᵀ z)): the same
+// pivots and z as the dense M, in the product form and in the dense form (which reads every column)
+TEST(Lemke, OperatorAgreesWithDenseMatrix) {
+  class Gram final : public LcpMatrixOperator {
+   public:
+    explicit Gram(const Eigen::MatrixXd& A) : A_(A) {}
+    Index size() const override { return A_.rows(); }
+    void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const override { out.noalias() = A_ * A_.row(j).transpose(); }
+    void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override {
+      out.noalias() = A_ * (A_.transpose() * z);
+    }
+    double maxAbs() const override { return A_.rowwise().squaredNorm().maxCoeff(); }
+
+   private:
+    const Eigen::MatrixXd& A_;
+  };
+  int compared = 0;
+  for (const bool product : {true, false}) {
+    LemkeOptions opt;
+    opt.product_form = product;
+    for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+      for (Index n : {12, 80, 200}) {
+        const auto c = gen::makeContactLike(n, seed);
+        LemkeWorkspace ws_dense, ws_op;
+        LcpResult dense, op;
+        dense.reserve(n);
+        op.reserve(n);
+        const Eigen::MatrixXd M = c.A * c.A.transpose();
+        ASSERT_EQ(solveLemke(M, c.lcp.q, ws_dense, opt, dense), LcpStatus::Solved) << dense.message;
+        ASSERT_EQ(solveLemke(Gram(c.A), c.lcp.q, ws_op, opt, op), LcpStatus::Solved) << op.message;
+        EXPECT_EQ(op.pivots, dense.pivots) << "n = " << n;
+        const double scale = std::max(1.0, dense.z.head(n).lpNorm<Eigen::Infinity>());
+        EXPECT_LE((op.z.head(n) - dense.z.head(n)).lpNorm<Eigen::Infinity>(), 1e-8 * scale) << "n = " << n;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 24);
+}
