@@ -434,3 +434,26 @@ TEST(Lemke, OperatorAgreesWithDenseMatrix) {
   }
   EXPECT_EQ(compared, 24);
 }
+
+// a path longer than the eta file (max_etas = 3 on contact-like problems of ~20 pivots): the product
+// form restarts in the dense form and ends on the dense form's answer; its pivot count includes the
+// abandoned product-form pivots
+TEST(Lemke, ProductFormRestartsDenseWhenItsEtaFileIsFull) {
+  int restarted = 0;
+  for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+    const auto c = gen::makeContactLike(60, seed);
+    LemkeWorkspace ws_product, ws_dense;
+    LemkeOptions small, dense;
+    small.max_etas = 3;
+    dense.product_form = false;
+    const LcpResult b = solveLemke(c.lcp, ws_dense, dense);
+    ASSERT_EQ(b.status, LcpStatus::Solved) << b.message;
+    const LcpResult a = solveLemke(c.lcp, ws_product, small);
+    ASSERT_EQ(a.status, LcpStatus::Solved) << a.message;
+    if (b.pivots <= 3) continue;  // the eta file was enough
+    ++restarted;
+    EXPECT_EQ(a.pivots, b.pivots + 3);  // 3 etas, the 4th pivot overflows and is not counted
+    EXPECT_LE((a.z - b.z).lpNorm<Eigen::Infinity>(), 1e-12 * std::max(1.0, b.z.lpNorm<Eigen::Infinity>()));
+  }
+  EXPECT_GE(restarted, 3);
+}

@@ -161,7 +161,7 @@ struct LemkeSolver {
   // product form: `col` holds the entering column (column(c)); it becomes an eta
   void pivot(Index r, Index c) {
     if (product) {
-      if (etas >= W().cols() - tie_cols) {
+      if (etas >= W().cols() - tie_cols || (opt.max_etas > 0 && etas >= opt.max_etas)) {
         overflow = true;
         return;
       }

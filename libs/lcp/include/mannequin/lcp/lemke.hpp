@@ -44,6 +44,9 @@ struct LemkeOptions {
   double check_tolerance = 1e-9;
   /// Product form of B⁻¹ (eta file) instead of the dense tableau (see the file comment).
   bool product_form = true;
+  /// Product form: at most this many etas before the restart in the dense form (0: as many as the
+  /// workspace's n×(n+1) buffer holds, ≈ n).
+  int max_etas = 0;
 };
 
 /// Pre-sized storage for solveLemke. Its buffers only grow: reserve(capacity) once and every later
