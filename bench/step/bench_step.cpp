@@ -15,10 +15,11 @@
 //       LCP row per contact; the feet keep their friction cones), F = the feet's floor rows (contacts:0 has
 //       no floor). Rows within the activation distance, mostly λ = 0: the LCP
 //       has them all, the active set is the feet's.
-//   BM_PhysicsStep/standing_hands_on_table   configs/control/default.yaml, gravity on (PhysicsConfig), both hands on
-//       two table tops (0.3 × 0.3 × 0.04 m boxes) under them, the hand targets 1 cm below the tops.
+//   BM_PhysicsStep/standing_hands_on_table   configs/control/default.yaml, gravity on (PhysicsConfig), standing
+//       on the floor with both hands resting palm down on a table in front (see handsOnTable: the set-up
+//       is checked and the case fails with an error when it is not what it claims).
 // Counters: contacts (mean contact rows per step, measured), active (λ > 0), lcp (LCP size), pivots,
-// per-stage µs (collision, constraints, integrate), max_pen_mm, lcp_failures, failed_steps.
+// per-stage µs (collision, constraints = rows + assemble + lcp, integrate), max_pen_mm, lcp_failures, failed_steps.
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -216,28 +217,35 @@ mocap::Frame still(const std::vector<math::SE3>& poses, std::int64_t stamp_ns) {
   return f;
 }
 
-/// Steps `run` (a still 120 Hz capture; calibrated on the first frame at the standing pose, then
-/// `targets`), 100 warm-up steps, then the measured ones.
-void measure(benchmark::State& state, PhysicsRun& run, const std::vector<math::SE3>& calibration) {
-  World& w = *run.world;
-  w.addMocap(still(calibration, 0));
-  w.anchor(0);
+/// Drives `run` with a still 120 Hz capture: calibrated on the first frame (`calibration`), then
+/// `run.targets` every 8 or 9 steps.
+struct Driver {
+  PhysicsRun& run;
   std::int64_t next_frame = 0;
-  const auto feed = [&] {
+  Driver(PhysicsRun& r, const std::vector<math::SE3>& calibration) : run(r) {
+    run.world->addMocap(still(calibration, 0));
+    run.world->anchor(0);
+  }
+  bool step() {
+    World& w = *run.world;
     if (w.captureTimeNs() >= next_frame) {
       next_frame += 8'333'333;
       w.addMocap(still(run.targets, next_frame));
     }
-  };
-  for (int i = 0; i < 100; ++i) {
-    feed();
-    w.step();
+    return w.step();
   }
+};
+
+/// Steps `run` (see Driver) `warmup` times (unless `driver` has already warmed it up), then the
+/// measured ones.
+void measure(benchmark::State& state, Driver& driver, int warmup = 100) {
+  World& w = *driver.run.world;
+  for (int i = 0; i < warmup; ++i) driver.step();
   double contacts = 0, active = 0, lcp = 0, pivots = 0, col = 0, cons = 0, integ = 0, max_pen = 0;
+  double produce = 0, assemble = 0, solve = 0;
   long n = 0;
   for (auto _ : state) {
-    feed();
-    benchmark::DoNotOptimize(w.step());
+    benchmark::DoNotOptimize(driver.step());
     const StepDiagnostics& dg = w.diagnostics();
     contacts += dg.contacts;
     active += dg.active_contacts;
@@ -246,6 +254,9 @@ void measure(benchmark::State& state, PhysicsRun& run, const std::vector<math::S
     col += dg.collision_s;
     cons += dg.constraints_s;
     integ += dg.integrate_s;
+    produce += dg.solver.produce_s;
+    assemble += dg.solver.assemble_s;
+    solve += dg.solver.solve_s;
     max_pen = std::max(max_pen, dg.max_penetration_m);
     ++n;
   }
@@ -256,10 +267,18 @@ void measure(benchmark::State& state, PhysicsRun& run, const std::vector<math::S
   state.counters["pivots"] = pivots * inv;
   state.counters["collision_us"] = 1e6 * col * inv;
   state.counters["constraints_us"] = 1e6 * cons * inv;
+  state.counters["rows_us"] = 1e6 * produce * inv;
+  state.counters["assemble_us"] = 1e6 * assemble * inv;
+  state.counters["lcp_us"] = 1e6 * solve * inv;
   state.counters["integrate_us"] = 1e6 * integ * inv;
   state.counters["max_pen_mm"] = 1e3 * max_pen;
   state.counters["lcp_failures"] = w.constraintSolver() ? static_cast<double>(w.constraintSolver()->failures()) : 0.0;
   state.counters["failed_steps"] = static_cast<double>(w.failedSteps());
+}
+
+void measure(benchmark::State& state, PhysicsRun& run, const std::vector<math::SE3>& calibration) {
+  Driver driver(run, calibration);
+  measure(state, driver);
 }
 
 constexpr double kSegmentMargin = 0.005;  // PhysicsConfig's default
@@ -290,40 +309,144 @@ void contactSweep(benchmark::State& state, int target) {
   measure(state, run, calibration);
 }
 
+/// Height of the lowest point of `segment`'s real geometry (no margin) above the floor z = 0, at `q`.
+double segmentBottom(const skeleton::Model& model, const skeleton::VectorX& q, const char* segment) {
+  skeleton::Data d(model);
+  skeleton::forwardKinematics(model, d, q);
+  collision::CollisionWorld cw(collision::WorldOptions{10.0, 1, 15.0});
+  cw.addScene(ringedScene(model, d, true, 0, 0.0));
+  collision::MannequinOptions mo;
+  mo.name = "operator";
+  mo.self_collision = false;
+  const int mi = cw.addMannequin(model, mo);
+  cw.updateMannequin(mi, d);
+  collision::ContactSet set;
+  cw.query(0, set);
+  const int body = cw.segmentBody(mi, model.findSegment(segment));
+  double bottom = std::numeric_limits<double>::infinity();
+  for (const collision::Contact& c : set.contacts)
+    if (c.body_a == body || c.body_b == body) bottom = std::min(bottom, c.distance);
+  return bottom;
+}
+
+/// The mannequin standing on the floor under gravity (configs/control/default.yaml), forearms forward,
+/// both hands resting palm down on one table in front of it and pressing on it (hand targets 1 cm
+/// below the top). Set-up: a first World without the table settles the pose (hands forward, 1 s);
+/// the table's top goes at the lower of the two hands' real geometry; the measured World is calibrated
+/// on the settled pose and warmed up 1 s before timing. Checked (SkipWithError otherwise) after the
+/// warm-up and after the run: each hand carries a normal force from the table, only hand and forearm
+/// segments touch the table, no real-geometry penetration beyond the segment margin, a foot on the
+/// floor with its sole within the margin of it.
 void handsOnTable(benchmark::State& state) {
   const skeleton::Model model =
       skeleton::buildMannequin(skeleton::loadMannequinSpec(mannequin::bench::dataFile("configs/mannequins/male_50th.yaml")));
   skeleton::Data d(model);
   skeleton::forwardKinematics(model, d, skeleton::standingConfiguration(model));
-  SceneSpec scene = ringedScene(model, d, true, 0, kSegmentMargin);
-  std::vector<math::SE3> calibration, targets;
-  for (const char* b : kBodies) calibration.push_back(d.oMf[static_cast<std::size_t>(model.frameIndex(b))]);
-  targets = calibration;
-  for (const char* hand : {"hand_l", "hand_r"}) {
-    // the lowest point of the hand's capsule: the top of its table (the margin shells touch)
-    const skeleton::Segment& seg = model.segments[static_cast<std::size_t>(model.findSegment(hand))];
-    collision::CollisionWorld cw(collision::WorldOptions{10.0, 1, 15.0});
-    cw.addScene(ringedScene(model, d, true, 0, 0.0));
-    collision::MannequinOptions mo;
-    mo.name = "operator";
-    mo.self_collision = false;
-    const int mi = cw.addMannequin(model, mo);
-    cw.updateMannequin(mi, d);
-    collision::ContactSet set;
-    cw.query(0, set);
-    const int body = cw.segmentBody(mi, model.findSegment(hand));
-    double bottom = std::numeric_limits<double>::infinity();  // height of the hand's lowest point above the floor
-    for (const collision::Contact& c : set.contacts)
-      if (c.body_a == body || c.body_b == body) bottom = std::min(bottom, c.distance);
-    const math::Vector3 com = d.oMi[static_cast<std::size_t>(seg.joint)].act(seg.com);
-    const double top = bottom - kSegmentMargin;
-    scene.bodies.push_back(staticBody(std::string("table_") + hand, collision::Shape::box(math::Vector3(0.3, 0.3, 0.04)),
-                                      at(math::Vector3(com.x(), com.y(), top - 0.02))));
-    for (std::size_t i = 0; i < std::size(kBodies); ++i)
-      if (std::string(kBodies[i]) == hand) targets[i].p.z() -= 0.01;  // pressing on the table
+  std::vector<math::SE3> standing, forward;
+  for (const char* b : kBodies) standing.push_back(d.oMf[static_cast<std::size_t>(model.frameIndex(b))]);
+  // forearms forward: wrists 0.32 m forward, 0.2 m up, 4 cm inwards; palms turned down by 0.8π about
+  // the forearm (pronation: +x for the left hand, −x for the right), fingers forward
+  forward = standing;
+  for (std::size_t i : {std::size_t{2}, std::size_t{3}}) {
+    const bool left = i == 2;  // hand_l is on +y
+    forward[i].p += math::Vector3(0.32, left ? -0.04 : 0.04, 0.20);
+    forward[i].R = math::expSO3(math::Vector3((left ? 0.8 : -0.8) * M_PI, 0, 0)) *
+                   math::expSO3(math::Vector3(0, -M_PI / 2, 0)) * standing[i].R;
   }
-  PhysicsRun run = physicsWorld(scene, "configs/control/default.yaml", &targets, math::Vector3(0, 0, -9.81));
-  measure(state, run, calibration);
+  const math::Vector3 gravity(0, 0, -9.81);
+  // 1. the pose without the table
+  SceneSpec floor_only = ringedScene(model, d, true, 0, kSegmentMargin);
+  PhysicsRun pre = physicsWorld(floor_only, "configs/control/default.yaml", &forward, gravity);
+  {
+    Driver drv(pre, standing);
+    for (int i = 0; i < 1000; ++i) drv.step();
+  }
+  std::vector<math::SE3> settled;
+  for (const DrivenFrame& f : pre.world->controlFrames(0)) settled.push_back(f.actual);
+  const skeleton::VectorX q_settled = pre.world->q(0);
+  const double top = std::min(segmentBottom(model, q_settled, "hand_l"), segmentBottom(model, q_settled, "hand_r"));
+  const double wrist_x = std::min(settled[2].p.x(), settled[3].p.x());
+  // 2. the table: 0.9 m wide, 0.5 m deep from 5 cm behind the wrists, 4 cm thick
+  SceneSpec scene = floor_only;
+  scene.bodies.push_back(staticBody("table", collision::Shape::box(math::Vector3(0.5, 0.9, 0.04)),
+                                    at(math::Vector3(wrist_x + 0.2, 0.5 * (settled[2].p.y() + settled[3].p.y()), top - 0.02))));
+  std::vector<math::SE3> pressing = settled;
+  pressing[2].p.z() -= 0.01;
+  pressing[3].p.z() -= 0.01;
+  // the hands come over the table first (from hanging at the sides), then press on it
+  std::vector<math::SE3> above = settled;
+  above[2].p.z() += 0.12;
+  above[3].p.z() += 0.12;
+  PhysicsRun run = physicsWorld(scene, "configs/control/default.yaml", &above, gravity);
+  Driver driver(run, standing);
+  World& w = *run.world;
+  const collision::CollisionWorld& cw = *w.collisionWorld();
+  const int table = cw.findBody("scene/table");
+  if (table < 0) {
+    state.SkipWithError("no body 'scene/table' in the World's collision world");
+    return;
+  }
+  // the set-up's claims over a window of steps
+  struct Check {
+    double force_l = 0, force_r = 0, max_pen = 0, worst_sole = 0;
+    int feet_on_floor = 0, steps = 0;
+    std::string other;  // a segment other than hands/forearms pressing on the table
+  };
+  const auto observe = [&](Check& c) {
+    ++c.steps;
+    const StepDiagnostics& dg = w.diagnostics();
+    c.max_pen = std::max(c.max_pen, dg.max_penetration_m);
+    const MannequinDiagnostics& md = w.mannequinDiagnostics(0);
+    if (md.foot_contact) ++c.feet_on_floor;
+    c.worst_sole = std::max(c.worst_sole, std::abs(md.sole_height_m));
+    for (const ContactReport& r : w.contacts()) {
+      if (r.body_a != table && r.body_b != table) continue;
+      const std::string& other = cw.bodyName(r.body_a == table ? r.body_b : r.body_a);
+      if (r.normal_force <= 0) continue;
+      if (other.find("hand_l") != std::string::npos) c.force_l += r.normal_force;
+      else if (other.find("hand_r") != std::string::npos) c.force_r += r.normal_force;
+      else if (other.find("forearm") == std::string::npos) c.other = other;
+    }
+  };
+  const auto verdict = [&](const Check& c, const char* when) -> std::string {
+    const double n = std::max(1, c.steps);
+    std::string e;
+    if (c.force_l / n < 1.0 || c.force_r / n < 1.0)
+      e = "a hand does not rest on the table (mean normal force L " + std::to_string(c.force_l / n) + " N, R " +
+          std::to_string(c.force_r / n) + " N)";
+    else if (!c.other.empty())
+      e = "'" + c.other + "' presses on the table";
+    else if (c.max_pen > kSegmentMargin)
+      e = "real-geometry penetration " + std::to_string(1e3 * c.max_pen) + " mm > the margin";
+    else if (c.feet_on_floor < c.steps || c.worst_sole > kSegmentMargin + 0.002)
+      e = "feet not on the floor (" + std::to_string(c.feet_on_floor) + "/" + std::to_string(c.steps) +
+          " steps, worst |sole height| " + std::to_string(1e3 * c.worst_sole) + " mm)";
+    return e.empty() ? e : std::string(when) + ": " + e;
+  };
+  for (int i = 0; i < 500; ++i) driver.step();
+  run.targets = pressing;
+  Check warm;
+  for (int i = 0; i < 1000; ++i) {
+    driver.step();
+    if (i >= 500) observe(warm);
+  }
+  if (const std::string e = verdict(warm, "after warm-up"); !e.empty()) {
+    state.SkipWithError(e.c_str());
+    return;
+  }
+  measure(state, driver, 0);
+  Check after;
+  for (int i = 0; i < 100; ++i) {
+    driver.step();
+    observe(after);
+  }
+  if (const std::string e = verdict(after, "after the run"); !e.empty()) {
+    state.SkipWithError(e.c_str());
+    return;
+  }
+  state.counters["hand_l_N"] = warm.force_l / warm.steps;
+  state.counters["hand_r_N"] = warm.force_r / warm.steps;
+  state.counters["table_top_m"] = top;
 }
 
 }  // namespace

@@ -51,23 +51,28 @@ TEST(Allocation, LemkeInPlaceAllocatesNothing) {
   LcpProblem ray{c.A * c.A.transpose(), c.lcp.q};
   ray.q[0] = -0.01;
   ray.q[1] = -0.01;
-  LemkeWorkspace ws(n);
-  LcpResult r;
-  solveLemke(ray, ws, {}, r);  // warm-up: sizes the result and the retry result
-  for (const LcpProblem* p : std::initializer_list<const LcpProblem*>{&spd, &trivial, &ray}) {
-    LcpStatus status = LcpStatus::Invalid;
-    const long allocations = countAllocations([&] {
-      const NoEigenMalloc no_eigen_malloc;
-      status = solveLemke(*p, ws, {}, r);
-    });
-    EXPECT_EQ(allocations, 0) << statusName(status);
-    EXPECT_EQ(status, r.status);
-    EXPECT_EQ(status, p == &ray ? LcpStatus::NoSolution : LcpStatus::Solved) << r.message;
-    // same answer as the allocating form
-    const LcpResult fresh = solveLemke(*p, ws);
-    EXPECT_EQ(fresh.status, r.status);
-    EXPECT_EQ(fresh.pivots, r.pivots);
-    EXPECT_EQ((fresh.z - r.z).lpNorm<Eigen::Infinity>(), 0.0);
+  // both forms of the pivoting (product form, the default, and the dense tableau)
+  for (const bool product : {true, false}) {
+    LemkeOptions opt;
+    opt.product_form = product;
+    LemkeWorkspace ws(n);
+    LcpResult r;
+    solveLemke(ray, ws, opt, r);  // warm-up: sizes the result and the retry result
+    for (const LcpProblem* p : std::initializer_list<const LcpProblem*>{&spd, &trivial, &ray}) {
+      LcpStatus status = LcpStatus::Invalid;
+      const long allocations = countAllocations([&] {
+        const NoEigenMalloc no_eigen_malloc;
+        status = solveLemke(*p, ws, opt, r);
+      });
+      EXPECT_EQ(allocations, 0) << statusName(status) << (product ? " (product form)" : " (dense)");
+      EXPECT_EQ(status, r.status);
+      EXPECT_EQ(status, p == &ray ? LcpStatus::NoSolution : LcpStatus::Solved) << r.message;
+      // same answer as the allocating form
+      const LcpResult fresh = solveLemke(*p, ws, opt);
+      EXPECT_EQ(fresh.status, r.status);
+      EXPECT_EQ(fresh.pivots, r.pivots);
+      EXPECT_EQ((fresh.z - r.z).lpNorm<Eigen::Infinity>(), 0.0);
+    }
   }
 }
 

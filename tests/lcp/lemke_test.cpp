@@ -360,3 +360,100 @@ TEST(Lemke, ContactLikeLarge) {
     expectSolved(solveLemke(c.lcp, ws));
   }
 }
+
+// the product form (eta file, the default) and the dense tableau follow the same pivoting rules: on
+// the same problems both solve, with the same pivot count and the same z up to rounding; includes
+// degenerate problems (zeros in q, repeated rows) where the lexicographic tie-break decides the path
+TEST(Lemke, ProductFormAgreesWithDenseTableau) {
+  LemkeWorkspace ws_product, ws_dense;
+  LemkeOptions dense;
+  dense.product_form = false;
+  int compared = 0;
+  const auto compare = [&](const LcpProblem& p, const std::string& what) {
+    const LcpResult a = solveLemke(p, ws_product);
+    const LcpResult b = solveLemke(p, ws_dense, dense);
+    ASSERT_EQ(a.status, b.status) << what;
+    if (b.status != LcpStatus::Solved) return;
+    EXPECT_EQ(a.pivots, b.pivots) << what;
+    const double scale = std::max(1.0, b.z.lpNorm<Eigen::Infinity>());
+    EXPECT_LE((a.z - b.z).lpNorm<Eigen::Infinity>(), 1e-8 * scale) << what;
+    ++compared;
+  };
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    for (Index n : {10, 60, 200}) compare(gen::makeContactLike(n, seed).lcp, "contact-like n=" + std::to_string(n));
+    compare(gen::makeSpd(25, seed), "spd");
+    compare(gen::makePMatrix(25, seed), "P");
+    LcpProblem d = psdWithSolution(8, 3, seed);
+    d.q.head(3).setZero();  // degenerate: zeros in q
+    compare(d, "zeros in q");
+    LcpProblem rep = psdWithSolution(8, 3, seed);
+    rep.M.row(1) = rep.M.row(0);  // repeated rows
+    rep.M.col(1) = rep.M.col(0);
+    rep.q[1] = rep.q[0];
+    compare(rep, "repeated rows");
+  }
+  EXPECT_GE(compared, 30);
+}
+
+// M given as an operator (M = A Aᵀ, never formed: columns A (Aᵀ e_j), products A (Aᵀ z)): the same
+// pivots and z as the dense M, in the product form and in the dense form (which reads every column)
+TEST(Lemke, OperatorAgreesWithDenseMatrix) {
+  class Gram final : public LcpMatrixOperator {
+   public:
+    explicit Gram(const Eigen::MatrixXd& A) : A_(A) {}
+    Index size() const override { return A_.rows(); }
+    void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const override { out.noalias() = A_ * A_.row(j).transpose(); }
+    void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override {
+      out.noalias() = A_ * (A_.transpose() * z);
+    }
+    double maxAbs() const override { return A_.rowwise().squaredNorm().maxCoeff(); }
+
+   private:
+    const Eigen::MatrixXd& A_;
+  };
+  int compared = 0;
+  for (const bool product : {true, false}) {
+    LemkeOptions opt;
+    opt.product_form = product;
+    for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+      for (Index n : {12, 80, 200}) {
+        const auto c = gen::makeContactLike(n, seed);
+        LemkeWorkspace ws_dense, ws_op;
+        LcpResult dense, op;
+        dense.reserve(n);
+        op.reserve(n);
+        const Eigen::MatrixXd M = c.A * c.A.transpose();
+        ASSERT_EQ(solveLemke(M, c.lcp.q, ws_dense, opt, dense), LcpStatus::Solved) << dense.message;
+        ASSERT_EQ(solveLemke(Gram(c.A), c.lcp.q, ws_op, opt, op), LcpStatus::Solved) << op.message;
+        EXPECT_EQ(op.pivots, dense.pivots) << "n = " << n;
+        const double scale = std::max(1.0, dense.z.head(n).lpNorm<Eigen::Infinity>());
+        EXPECT_LE((op.z.head(n) - dense.z.head(n)).lpNorm<Eigen::Infinity>(), 1e-8 * scale) << "n = " << n;
+        ++compared;
+      }
+    }
+  }
+  EXPECT_EQ(compared, 24);
+}
+
+// a path longer than the eta file (max_etas = 3 on contact-like problems of ~20 pivots): the product
+// form restarts in the dense form and ends on the dense form's answer; its pivot count includes the
+// abandoned product-form pivots
+TEST(Lemke, ProductFormRestartsDenseWhenItsEtaFileIsFull) {
+  int restarted = 0;
+  for (std::uint32_t seed = 1; seed <= 4; ++seed) {
+    const auto c = gen::makeContactLike(60, seed);
+    LemkeWorkspace ws_product, ws_dense;
+    LemkeOptions small, dense;
+    small.max_etas = 3;
+    dense.product_form = false;
+    const LcpResult b = solveLemke(c.lcp, ws_dense, dense);
+    ASSERT_EQ(b.status, LcpStatus::Solved) << b.message;
+    const LcpResult a = solveLemke(c.lcp, ws_product, small);
+    ASSERT_EQ(a.status, LcpStatus::Solved) << a.message;
+    if (b.pivots <= 3) continue;  // the eta file was enough
+    ++restarted;
+    EXPECT_EQ(a.pivots, b.pivots + 3);  // 3 etas, the 4th pivot overflows and is not counted
+    EXPECT_LE((a.z - b.z).lpNorm<Eigen::Infinity>(), 1e-12 * std::max(1.0, b.z.lpNorm<Eigen::Infinity>()));
+  }
+  EXPECT_GE(restarted, 3);
+}

@@ -29,9 +29,9 @@ RowSet::RowSet(const std::vector<int>& system_nv, int max_rows, int max_friction
     throw std::invalid_argument("RowSet: needs max_rows >= 0, 0 <= max_friction_rows <= max_rows, max_edges >= 1");
   for (std::size_t s = 0; s < system_nv.size(); ++s) {
     if (system_nv[s] < 0) throw std::invalid_argument("RowSet: system " + std::to_string(s) + " has nv < 0");
-    J_.emplace_back(Eigen::MatrixXd::Zero(max_rows + 1, system_nv[s]));
-    T1_.emplace_back(Eigen::MatrixXd::Zero(max_friction_rows + 1, system_nv[s]));
-    T2_.emplace_back(Eigen::MatrixXd::Zero(max_friction_rows + 1, system_nv[s]));
+    J_.emplace_back(RowMatrix::Zero(max_rows + 1, system_nv[s]));
+    T1_.emplace_back(RowMatrix::Zero(max_friction_rows + 1, system_nv[s]));
+    T2_.emplace_back(RowMatrix::Zero(max_friction_rows + 1, system_nv[s]));
   }
   info_.resize(static_cast<std::size_t>(max_rows));
   slot_.assign(static_cast<std::size_t>(max_rows), -1);
@@ -68,15 +68,15 @@ int RowSet::add(const RowInfo& info) {
   return r;
 }
 
-Eigen::Block<Eigen::MatrixXd, 1, Eigen::Dynamic, false> RowSet::jacobian(int r, int s) {
-  Eigen::MatrixXd& J = J_[static_cast<std::size_t>(s)];
+RowSet::RowBlock RowSet::jacobian(int r, int s) {
+  RowMatrix& J = J_[static_cast<std::size_t>(s)];
   if (r < 0 || r >= n_) return J.row(J.rows() - 1);  // the sink
   touch_[static_cast<std::size_t>(r)] |= std::uint64_t{1} << s;
   return J.row(r);
 }
 
-Eigen::Block<Eigen::MatrixXd, 1, Eigen::Dynamic, false> RowSet::tangent(int r, int s, int which) {
-  Eigen::MatrixXd& T = which == 0 ? T1_[static_cast<std::size_t>(s)] : T2_[static_cast<std::size_t>(s)];
+RowSet::RowBlock RowSet::tangent(int r, int s, int which) {
+  RowMatrix& T = which == 0 ? T1_[static_cast<std::size_t>(s)] : T2_[static_cast<std::size_t>(s)];
   if (r < 0 || r >= n_ || slot_[static_cast<std::size_t>(r)] < 0) return T.row(T.rows() - 1);  // the sink
   touch_[static_cast<std::size_t>(r)] |= std::uint64_t{1} << s;
   return T.row(slot_[static_cast<std::size_t>(r)]);

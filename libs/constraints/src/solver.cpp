@@ -44,20 +44,77 @@ std::vector<int> systemSizes(const std::vector<ConstrainedSystem*>& systems, con
 
 }  // namespace
 
+// The step's LCP matrix, never formed: M = [Σ_s X_sᵀ X_s  0; 0 0] (force rows; X_s = L_s⁻¹ R_sᵀ) plus
+// the friction structure (w_edge = … + γ, w_γ = μλ − Σβ): Lemke's product form reads only the
+// columns of the variables entering its basis, O(n Σ nv_s) each, instead of the O(n² Σ nv_s) product.
+class DelassusOperator final : public lcp::LcpMatrixOperator {
+ public:
+  struct Data {
+    const std::vector<Eigen::MatrixXd>* X = nullptr;  // per system: nv_s × cap_f (leading nF columns valid)
+    std::vector<Eigen::VectorXd>* scratch = nullptr;  // per system: nv_s
+    std::uint64_t touched = 0;
+    int ns = 0, nF = 0, n = 0;
+    const std::vector<int>* fric = nullptr;  // friction rows: (p, first edge, edges, γ) quadruples
+    int nfric = 0;
+    const std::vector<double>* mu = nullptr;  // per friction row
+    double max_abs = 0.0;
+  };
+  explicit DelassusOperator(const Data& d) : d_(d) {}
+  Eigen::Index size() const override { return d_.n; }
+  void column(Eigen::Index j, Eigen::Ref<Eigen::VectorXd> out) const override {
+    out.setZero();
+    if (j < d_.nF) {
+      for (int s = 0; s < d_.ns; ++s) {
+        if (!((d_.touched >> s) & 1u)) continue;
+        const auto X = (*d_.X)[static_cast<std::size_t>(s)].leftCols(d_.nF);
+        out.head(d_.nF).noalias() += X.transpose() * X.col(j);
+      }
+    }
+    for (int f = 0; f < d_.nfric; ++f) {
+      const int* e = &(*d_.fric)[static_cast<std::size_t>(4 * f)];
+      if (j == e[0]) out[e[3]] += (*d_.mu)[static_cast<std::size_t>(f)];
+      if (j >= e[1] && j < e[1] + e[2]) out[e[3]] -= 1.0;
+      if (j == e[3]) out.segment(e[1], e[2]).array() += 1.0;
+    }
+  }
+  void multiply(const lcp::VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override {
+    out.setZero();
+    for (int s = 0; s < d_.ns; ++s) {
+      if (!((d_.touched >> s) & 1u)) continue;
+      const auto X = (*d_.X)[static_cast<std::size_t>(s)].leftCols(d_.nF);
+      Eigen::VectorXd& t = (*d_.scratch)[static_cast<std::size_t>(s)];
+      t.noalias() = X * z.head(d_.nF);
+      out.head(d_.nF).noalias() += X.transpose() * t;
+    }
+    for (int f = 0; f < d_.nfric; ++f) {
+      const int* e = &(*d_.fric)[static_cast<std::size_t>(4 * f)];
+      out[e[3]] += (*d_.mu)[static_cast<std::size_t>(f)] * z[e[0]] - z.segment(e[1], e[2]).sum();
+      out.segment(e[1], e[2]).array() += z[e[3]];
+    }
+  }
+  double maxAbs() const override { return d_.max_abs; }
+
+ private:
+  Data d_;
+};
+
 // LCP layout of a step: z = [normal/limit rows and bilateral halves (nN) | friction edges (nE) |
 // sliding speeds γ (nG)]; the force rows are the first nF = nN + nE. Buffers whose size is linear in
-// the capacity are allocated here; the n²-sized ones (M, Lemke's tableau, PGS's Mᵀ) grow to the
+// the capacity are allocated here; the n²-sized ones (M for PGS, Lemke's tableau, PGS's Mᵀ) grow to the
 // largest LCP seen (never beyond the capacity), so solve() allocates nothing after that warm-up.
 struct ConstraintSolver::Impl {
   using Index = Eigen::Index;
   int cap_n = 0, cap_f = 0, cap_nn = 0;  // LCP, force rows, frictionless rows
   int m_total = 0;                       // Σ nv_s
-  std::vector<Eigen::MatrixXd> R;        // per system: cap_f × nv_s, force rows R_s
+  std::vector<Eigen::MatrixXd> Rt;       // per system: nv_s × cap_f, force rows R_s (transposed)
   std::vector<Eigen::MatrixXd> X;        // per system: nv_s × cap_f, L_s⁻¹ R_sᵀ
   std::vector<Eigen::VectorXd> gamma;    // per system: nv_s, Γ_s
   std::vector<Eigen::VectorXd> velocity; // per system: nv_s, q̇_s of the current answer (refinement)
   std::vector<int> pos, neg, edge, gam;  // per row: index of λ (+ half), − half, first edge, γ
-  Eigen::MatrixXd M;                     // grows: n × n
+  std::vector<int> fric;                 // per friction row: p, first edge, edges, γ (DelassusOperator)
+  std::vector<double> mu;                // per friction row
+  Eigen::VectorXd diag;                  // cap_f: diagonal of Σ_s X_sᵀ X_s
+  Eigen::MatrixXd M;                     // grows: n × n (PGS's frictionless block, on a fallback)
   Eigen::VectorXd q;                     // cap_n
   Eigen::VectorXd q_base;                // cap_n: q without the distance terms (refinement)
   Eigen::VectorXd z_prev;                // cap_n: the answer before a re-solve (refinement)
@@ -78,6 +135,27 @@ struct ConstraintSolver::Impl {
   }
 };
 
+namespace {
+// the frictionless Delassus block Σ_s X_sᵀ X_s (nN × nN, in im.M) for PGS: only on a fallback
+template <typename Impl>
+void pgsMatrix(Impl& im, std::uint64_t touched, int ns, int nN) {
+  auto M = im.M.topLeftCorner(nN, nN);
+  M.setZero();
+  for (int s = 0; s < ns; ++s) {
+    if (!((touched >> s) & 1u)) continue;
+    const auto X = im.X[static_cast<std::size_t>(s)].leftCols(nN);
+    for (int i0 = 0; i0 < nN; i0 += kPanel) {
+      const int ni = std::min(kPanel, nN - i0);
+      for (int j0 = i0; j0 < nN; j0 += kPanel) {
+        const int nj = std::min(kPanel, nN - j0);
+        M.block(i0, j0, ni, nj).noalias() += X.middleCols(i0, ni).transpose() * X.middleCols(j0, nj);
+        if (j0 != i0) M.block(j0, i0, nj, ni) = M.block(i0, j0, ni, nj).transpose();
+      }
+    }
+  }
+}
+}  // namespace
+
 ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, const SolverOptions& options)
     : impl_(std::make_unique<Impl>()),
       systems_(std::move(systems)),
@@ -89,7 +167,7 @@ ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, cons
   im.cap_n = im.cap_f + options.max_friction_rows;
   for (ConstrainedSystem* s : systems_) {
     const int nv = s->nv();
-    im.R.emplace_back(Eigen::MatrixXd::Zero(im.cap_f, nv));
+    im.Rt.emplace_back(Eigen::MatrixXd::Zero(nv, im.cap_f));
     im.X.emplace_back(Eigen::MatrixXd::Zero(nv, im.cap_f));
     im.gamma.emplace_back(Eigen::VectorXd::Zero(nv));
     im.velocity.emplace_back(Eigen::VectorXd::Zero(nv));
@@ -100,6 +178,9 @@ ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, cons
   im.neg.assign(mr, -1);
   im.edge.assign(mr, -1);
   im.gam.assign(mr, -1);
+  im.fric.assign(4 * mr, 0);
+  im.mu.assign(mr, 0.0);
+  im.diag = Eigen::VectorXd::Zero(im.cap_f);
   im.q = Eigen::VectorXd::Zero(im.cap_n);
   im.q_base = Eigen::VectorXd::Zero(im.cap_n);
   im.z_prev = Eigen::VectorXd::Zero(im.cap_n);
@@ -142,7 +223,7 @@ const SolveReport& ConstraintSolver::solve(double dt) {
     return rep;
   }
   lcp::LcpResult& res = im.result;
-  int nr = 0, nN = 0, nF = 0, nz = 0, col = 0;  // nz: force rows of the answer
+  int nr = 0, nN = 0, nF = 0, nz = 0;  // nz: force rows of the answer
   std::uint64_t touched = 0;
   int rounds_left = options_.refine_rounds;
   auto t2 = t1;
@@ -177,31 +258,32 @@ const SolveReport& ConstraintSolver::solve(double dt) {
     const int n = nF + nG;
     for (int r = 0, g = 0; r < nr; ++r) im.gam[static_cast<std::size_t>(r)] = rows_.frictionSlot(r) >= 0 ? nF + g++ : -1;
     im.grow(n);
-    auto M = im.M.topLeftCorner(n, n);
     auto q = im.q.head(n);
-    M.setZero();
     q.setZero();
-    // force rows per touched system, Delassus A = Σ_s R_s b_s⁻¹ R_sᵀ = Σ_s X_sᵀ X_s, q = R q̇_free + d/δt
-    col = 0;
+    auto diag = im.diag.head(nF);
+    diag.setZero();
+    // force rows per touched system, X_s = L_s⁻¹ R_sᵀ (the Delassus matrix Σ_s X_sᵀ X_s is not formed:
+    // DelassusOperator), q = R q̇_free + d/δt
     for (int s = 0; s < ns; ++s) {
       if (!((touched >> s) & 1u)) continue;
       const auto us = static_cast<std::size_t>(s);
-      const Eigen::MatrixXd& J = rows_.jacobians(s);
-      auto R = im.R[us].topRows(nF);
+      const RowSet::RowMatrix& J = rows_.jacobians(s);
+      auto Rt = im.Rt[us].leftCols(nF);
       for (int r = 0; r < nr; ++r) {
         const auto ur = static_cast<std::size_t>(r);
-        R.row(im.pos[ur]) = J.row(r);
-        if (im.neg[ur] >= 0) R.row(im.neg[ur]) = -J.row(r);
+        Rt.col(im.pos[ur]) = J.row(r).transpose();
+        if (im.neg[ur] >= 0) Rt.col(im.neg[ur]) = -J.row(r).transpose();
         const int slot = rows_.frictionSlot(r);
         if (slot < 0) continue;
         const int m = rows_.info(r).friction_edges;
         for (int k = 0; k < m; ++k) {
           const double th = 2.0 * std::numbers::pi * k / m;
-          R.row(im.edge[ur] + k) = std::cos(th) * rows_.tangents(s, 0).row(slot) + std::sin(th) * rows_.tangents(s, 1).row(slot);
+          Rt.col(im.edge[ur] + k) =
+              (std::cos(th) * rows_.tangents(s, 0).row(slot) + std::sin(th) * rows_.tangents(s, 1).row(slot)).transpose();
         }
       }
       auto X = im.X[us].leftCols(nF);
-      X = R.transpose();
+      X = Rt;
       // in panels of kPanel columns: Eigen's blocked kernels then keep their packing buffers on the
       // stack (under EIGEN_STACK_ALLOCATION_LIMIT) instead of allocating them for large n
       const auto L = systems_[us]->frictionLLT().matrixL();
@@ -209,18 +291,8 @@ const SolveReport& ConstraintSolver::solve(double dt) {
         auto Xc = X.middleCols(c0, std::min(kPanel, nF - c0));
         L.solveInPlace(Xc);  // L⁻¹ Rᵀ
       }
-      for (int i0 = 0; i0 < nF; i0 += kPanel) {
-        const int ni = std::min(kPanel, nF - i0);
-        for (int j0 = i0; j0 < nF; j0 += kPanel) {
-          const int nj = std::min(kPanel, nF - j0);
-          M.block(i0, j0, ni, nj).noalias() += X.middleCols(i0, ni).transpose() * X.middleCols(j0, nj);
-          if (j0 != i0) M.block(j0, i0, nj, ni) = M.block(i0, j0, ni, nj).transpose();
-        }
-      }
-      q.head(nF).noalias() += R * systems_[us]->qdotFree();
-      const int nv = static_cast<int>(X.rows());
-      im.A.block(0, col, nN, nv) = X.leftCols(nN).transpose();  // frictionless A = [R_s L_s⁻ᵀ]_s
-      col += nv;
+      diag += X.colwise().squaredNorm().transpose();
+      q.head(nF).noalias() += Rt.transpose() * systems_[us]->qdotFree();
     }
     im.q_base.head(n) = q;
     // the distance terms max(±d/δt, −v_rec) + ±correction/δt of the force rows
@@ -235,18 +307,33 @@ const SolveReport& ConstraintSolver::solve(double dt) {
       }
     };
     addDistances();
+    double max_abs = nF > 0 ? diag.maxCoeff() : 0.0;  // |M_ij| ≤ √(M_ii M_jj) on the PSD block
+    int nfric = 0;
     for (int r = 0; r < nr; ++r) {
       const RowInfo& in = rows_.info(r);
       const auto ur = static_cast<std::size_t>(r);
       if (im.gam[ur] < 0) continue;
       // edges: w = t_k q̇ + γ; cone: w_γ = μλ − Σβ
-      const int m = in.friction_edges, g = im.gam[ur], p = im.pos[ur];
-      M(g, p) = in.mu;
-      for (int k = 0; k < m; ++k) {
-        M(im.edge[ur] + k, g) = 1.0;
-        M(g, im.edge[ur] + k) = -1.0;
-      }
+      const auto f = static_cast<std::size_t>(nfric++);
+      im.fric[4 * f] = im.pos[ur];
+      im.fric[4 * f + 1] = im.edge[ur];
+      im.fric[4 * f + 2] = in.friction_edges;
+      im.fric[4 * f + 3] = im.gam[ur];
+      im.mu[f] = in.mu;
+      max_abs = std::max({max_abs, std::abs(in.mu), 1.0});
     }
+    DelassusOperator::Data od;
+    od.X = &im.X;
+    od.scratch = &im.gamma;  // free until step 4
+    od.touched = touched;
+    od.ns = ns;
+    od.nF = nF;
+    od.n = n;
+    od.fric = &im.fric;
+    od.nfric = nfric;
+    od.mu = &im.mu;
+    od.max_abs = max_abs;
+    const DelassusOperator M(od);
     t2 = Clock::now();
     rep.assemble_s = seconds(t1, t2);
     rep.lcp_size = n;
@@ -270,7 +357,7 @@ const SolveReport& ConstraintSolver::solve(double dt) {
           const auto us = static_cast<std::size_t>(s);
           Eigen::VectorXd& v = im.velocity[us];
           if ((touched >> s) & 1u) {
-            v.noalias() = im.R[us].topRows(nF).transpose() * res.z.head(nF);
+            v.noalias() = im.Rt[us].leftCols(nF) * res.z.head(nF);
             systems_[us]->frictionLLT().solveInPlace(v);  // b⁻¹Γ
             v += systems_[us]->qdotFree();
           } else {
@@ -302,19 +389,29 @@ const SolveReport& ConstraintSolver::solve(double dt) {
       rep.fallback = true;
       ++failures_;
       rep.lcp_size = nN;
+      // frictionless A = [R_s L_s⁻ᵀ]_s
+      int col = 0;
+      for (int s = 0; s < ns; ++s) {
+        if (!((touched >> s) & 1u)) continue;
+        const auto Xs = im.X[static_cast<std::size_t>(s)].leftCols(nN);
+        im.A.block(0, col, nN, Xs.rows()) = Xs.transpose();
+        col += static_cast<int>(Xs.rows());
+      }
       const auto An = im.A.topLeftCorner(nN, col);
       const auto qn = im.q.head(nN);
-      if (lcp::solveStructured(An, qn, im.structured, options_.structured, res) == lcp::LcpStatus::Solved &&
-          res.z.head(nN).allFinite()) {
+      const auto solvedWith = [&](lcp::LcpStatus st) { return st == lcp::LcpStatus::Solved && res.z.head(nN).allFinite(); };
+      if (solvedWith(lcp::solveStructured(An, qn, im.structured, options_.structured, res))) {
         rep.solver = SolverUsed::kStructured;
         nz = nN;
-      } else if (lcp::solvePgs(im.M.topLeftCorner(nN, nN), qn, im.pgs, options_.pgs, res) == lcp::LcpStatus::Solved &&
-                 res.z.head(nN).allFinite()) {
-        rep.solver = SolverUsed::kPgs;
-        nz = nN;
       } else {
-        rep.solver = SolverUsed::kFailed;
-        ++unsolved_;
+        pgsMatrix(im, touched, ns, nN);
+        if (solvedWith(lcp::solvePgs(im.M.topLeftCorner(nN, nN), qn, im.pgs, options_.pgs, res))) {
+          rep.solver = SolverUsed::kPgs;
+          nz = nN;
+        } else {
+          rep.solver = SolverUsed::kFailed;
+          ++unsolved_;
+        }
       }
       rep.pivots = res.pivots;
     }
@@ -326,7 +423,7 @@ const SolveReport& ConstraintSolver::solve(double dt) {
     for (int s = 0; s < ns; ++s) {
       if (!((touched >> s) & 1u)) continue;
       const auto us = static_cast<std::size_t>(s);
-      im.gamma[us].noalias() = im.R[us].topRows(nz).transpose() * z;
+      im.gamma[us].noalias() = im.Rt[us].leftCols(nz) * z;
       systems_[us]->applyConstraintForce(im.gamma[us]);
     }
   }

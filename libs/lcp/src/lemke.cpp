@@ -22,6 +22,8 @@ void LemkeWorkspace::reserve(Index capacity) {
   where_.reserve(static_cast<std::size_t>(2 * capacity + 1));
   ties_.reserve(static_cast<std::size_t>(capacity));
   keep_.reserve(static_cast<std::size_t>(capacity));
+  eta_row_.reserve(static_cast<std::size_t>(capacity + 1));
+  tie_col_.reserve(static_cast<std::size_t>(capacity));
   retry_.reserve(capacity);
 }
 
@@ -34,12 +36,27 @@ void LemkeWorkspace::resize(Index n) {
   where_.assign(static_cast<std::size_t>(2 * n + 1), 0);
 }
 
+namespace {
+// a dense M as an operator
+class DenseMatrix final : public LcpMatrixOperator {
+ public:
+  explicit DenseMatrix(const MatrixView& M) : M_(M) {}  // a view of M (no copy)
+  Index size() const override { return M_.rows(); }
+  void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const override { out = M_.col(j); }
+  void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override { out.noalias() = M_ * z; }
+  double maxAbs() const override { return M_.size() > 0 ? M_.cwiseAbs().maxCoeff() : 0.0; }
+
+ private:
+  MatrixView M_;
+};
+}  // namespace
+
 // the pivoting engine; variables are numbered w_i = i, z_i = n + i, z0 = 2n
 struct LemkeSolver {
   using Tableau = Eigen::Block<Eigen::MatrixXd>;
   using Segment = Eigen::VectorBlock<Eigen::VectorXd>;
   LemkeWorkspace& ws;
-  const MatrixView& M;
+  const LcpMatrixOperator& M;
   const VectorView& q;
   const LemkeOptions& opt;
   double pivot_tolerance;  // opt's, or a retry's
@@ -51,20 +68,83 @@ struct LemkeSolver {
       resid{ws.resid_, 0, n}, delta{ws.delta_, 0, n};
   double scale = 1.0;
   double min_rel_pivot = 1.0;  // smallest |pivot| / ‖column‖∞ met on the path
+  bool product = false;        // product form (eta file in the tableau's columns)
+  bool overflow = false;       // product form: the eta file is full (restart dense)
+  Index etas = 0;              // product form: eta columns in use
+  Index tie_cols = 0;          // product form: B⁻¹ rows cached from the right end
 
   static std::size_t u(Index i) { return static_cast<std::size_t>(i); }
+
+  // the full workspace buffer (product form: etas and cached rows, n rows each)
+  Eigen::MatrixXd& W() { return ws.tableau_; }
 
   // entry (i, j) of B⁻¹: the tableau column of w_j, or a unit column when w_j is basic
   double binv(Index i, Index j) const {
     const int pos = ws.where_[u(j)];
     if (pos >= 0) return pos == i ? 1.0 : 0.0;
+    if (product) return ws.tableau_(j, ws.tie_col_[u(i)]);
     return T(i, -pos - 1);
+  }
+
+  // product form: v ← E_k ⋯ E_1 v (B⁻¹ v)
+  template <typename V>
+  void applyEtas(V&& v) const {
+    for (Index k = 0; k < etas; ++k) {
+      const Index r = ws.eta_row_[u(k)];
+      const auto d = ws.tableau_.col(k).head(n);
+      const double t = v[r] / d[r];
+      if (t != 0.0) v.noalias() -= t * d;
+      v[r] = t;
+    }
+  }
+
+  // product form: the column of B⁻¹ [I, −M, −d] for the non-basic column c, into `col`
+  void column(Index c) {
+    const int var = ws.nonbasic_[u(c)];
+    if (var < n) {
+      col.setZero();
+      col[var] = 1.0;
+    } else if (var < 2 * n) {
+      M.column(var - n, col);
+      col = -col;
+    } else {
+      col = -cover;
+    }
+    applyEtas(col);
+  }
+
+  // product form: row i of B⁻¹ (eᵢᵀ E_k ⋯ E_1) cached in a column from the right end of the buffer;
+  // false when the buffer is full
+  bool cacheRow(Index i) {
+    if (ws.tie_col_[u(i)] >= 0) return true;
+    const Index c = W().cols() - 1 - tie_cols;
+    if (c < etas) return false;
+    ++tie_cols;
+    ws.tie_col_[u(i)] = static_cast<int>(c);
+    auto v = W().col(c).head(n);
+    v.setZero();
+    v[i] = 1.0;
+    for (Index k = etas - 1; k >= 0; --k) {
+      const Index r = ws.eta_row_[u(k)];
+      const auto d = ws.tableau_.col(k).head(n);
+      v[r] = (v[r] - v.dot(d) + v[r] * d[r]) / d[r];
+    }
+    return true;
   }
 
   // fresh tableau: basis w, non-basic columns z (−M) then z0 (−d)
   void setup() {
-    T.leftCols(n) = -M;
-    T.col(n) = -cover;
+    if (product) {
+      etas = 0;
+      ws.eta_row_.clear();
+      ws.tie_col_.assign(u(n), -1);
+    } else {
+      for (Index j = 0; j < n; ++j) {
+        M.column(j, T.col(j));
+        T.col(j) = -T.col(j);
+      }
+      T.col(n) = -cover;
+    }
     rhs = q;
     for (Index i = 0; i < n; ++i) {
       ws.basic_[u(i)] = static_cast<int>(i);
@@ -78,7 +158,26 @@ struct LemkeSolver {
 
   // Jordan exchange on (r, c), in place: the entering variable of column c becomes basic in
   // row r and the leaving one takes column c
+  // product form: `col` holds the entering column (column(c)); it becomes an eta
   void pivot(Index r, Index c) {
+    if (product) {
+      if (etas >= W().cols() - tie_cols || (opt.max_etas > 0 && etas >= opt.max_etas)) {
+        overflow = true;
+        return;
+      }
+      const double piv = col[r];
+      W().col(etas).head(n) = col;
+      ws.eta_row_.push_back(static_cast<int>(r));
+      ++etas;
+      const double xr = rhs[r] / piv;
+      rhs.noalias() -= xr * col;
+      rhs[r] = xr;
+      book(r, c);
+      // the rows cached for ties belong to the old basis
+      for (int& tc : ws.tie_col_) tc = -1;
+      tie_cols = 0;
+      return;
+    }
     const double piv = T(r, c);
     col = T.col(c);
     row = T.row(r).transpose() / piv;
@@ -93,7 +192,11 @@ struct LemkeSolver {
     const double xr = rhs[r] / piv;
     rhs.noalias() -= xr * col;
     rhs[r] = xr;
-    // bookkeeping
+    book(r, c);
+  }
+
+  // bookkeeping of an exchange on (r, c)
+  void book(Index r, Index c) {
     const int entering = ws.nonbasic_[u(c)];
     const int leaving = ws.basic_[u(r)];
     ws.basic_[u(r)] = entering;
@@ -103,8 +206,9 @@ struct LemkeSolver {
   }
 
   // lexicographic minimum ratio test on column c; −1 means no blocking row (a ray)
+  // (product form: on `col`, filled by column(c))
   Index ratioTest(Index c) {
-    const auto column = T.col(c);
+    const auto column = product ? Eigen::Ref<const Eigen::VectorXd>(col) : Eigen::Ref<const Eigen::VectorXd>(T.col(c));
     const double tol = pivot_tolerance * std::max(column.cwiseAbs().maxCoeff(), scale);
     // minimum ratio over the blocking rows
     double best = std::numeric_limits<double>::infinity();
@@ -123,6 +227,14 @@ struct LemkeSolver {
       }
     }
     // break ties on the rows of B⁻¹ divided by the pivot entry, column by column
+    if (product && ws.ties_.size() > 1) {
+      for (int i : ws.ties_) {
+        if (!cacheRow(i)) {
+          overflow = true;
+          return -1;
+        }
+      }
+    }
     for (Index j = 0; j < n && ws.ties_.size() > 1; ++j) {
       const int pos = ws.where_[u(j)];
       if (pos >= 0) {
@@ -152,15 +264,24 @@ struct LemkeSolver {
   // one step of iterative refinement of the basic values: rhs += B⁻¹ (q − B rhs)
   void refine() {
     resid = q;
+    delta.setZero();  // the basic z's (scratch)
     for (Index i = 0; i < n; ++i) {
       const int v = ws.basic_[u(i)];
       if (v < n) {
         resid[v] -= rhs[i];
       } else if (v < 2 * n) {
-        resid.noalias() += M.col(v - n) * rhs[i];
+        delta[v - n] = rhs[i];
       } else {
         resid.noalias() += cover * rhs[i];
       }
+    }
+    M.multiply(delta, col);  // col is free after the path
+    resid += col;
+    if (product) {
+      delta = resid;
+      applyEtas(delta);
+      rhs += delta;
+      return;
     }
     delta.setZero();
     for (Index j = 0; j < n; ++j) {
@@ -187,18 +308,22 @@ struct LemkeSolver {
 namespace {
 
 // fills w = Mz + q and the residuals of z, w (n-entry views); keeps everything finite
-void finish(const MatrixView& M, const VectorView& q, Eigen::VectorBlock<Eigen::VectorXd> z,
+void finish(const LcpMatrixOperator& M, const VectorView& q, Eigen::VectorBlock<Eigen::VectorXd> z,
             Eigen::VectorBlock<Eigen::VectorXd> w, LcpResult& res) {
   if (!z.allFinite()) z.setZero();
-  w.noalias() = M * z;
+  M.multiply(z, w);
   w += q;
   res.residuals = computeResiduals(q, z, w);
 }
 
 // one complementary pivoting run with covering vector workspace.cover_ already set and the given
 // pivot tolerance (the retries change it), written into the first n entries of res.z, res.w
-void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+void lemkeAttempt(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace,
                   const LemkeOptions& options, double pivot_tolerance, LcpResult& res);
+// one run in the requested form: the product form falls back to the dense one when its eta file
+// is full (the pivots so far are counted)
+bool lemkeRun(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace, const LemkeOptions& options,
+              double pivot_tolerance, bool product, LcpResult& res);
 
 // an answer with no solution vectors (invalid input)
 LcpStatus invalid(LcpResult& res, const char* message) {
@@ -210,7 +335,7 @@ LcpStatus invalid(LcpResult& res, const char* message) {
 }
 
 // the solve on views, into the first n entries of res.z, res.w (at least n entries each)
-LcpStatus solveViews(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+LcpStatus solveViews(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace,
                      const LemkeOptions& options, LcpResult& res) {
   const Index n = q.size();
   // trivial solution z = 0 when q ≥ 0
@@ -297,7 +422,7 @@ LcpStatus solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace, const
   const Index n = problem.q.size();
   res.z.resize(n);
   res.w.resize(n);
-  return solveViews(problem.M, problem.q, workspace, options, res);
+  return solveViews(DenseMatrix(problem.M), problem.q, workspace, options, res);
 }
 
 LcpStatus solveLemke(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
@@ -308,18 +433,39 @@ LcpStatus solveLemke(const MatrixView& M, const VectorView& q, LemkeWorkspace& w
     err = "result.z and result.w need at least n entries (LcpResult::reserve)";
   }
   if (err != nullptr) return invalid(result, err);
+  return solveViews(DenseMatrix(M), q, workspace, options, result);
+}
+
+LcpStatus solveLemke(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace,
+                     const LemkeOptions& options, LcpResult& result) {
+  const char* err = M.size() != q.size() ? "q and M sizes differ" : nullptr;
+  if (err == nullptr && !q.allFinite()) err = "q has a NaN or Inf entry";
+  if (err == nullptr) err = checkOptions(options, q.size());
+  if (err == nullptr && (result.z.size() < q.size() || result.w.size() < q.size())) {
+    err = "result.z and result.w need at least n entries (LcpResult::reserve)";
+  }
+  if (err != nullptr) return invalid(result, err);
   return solveViews(M, q, workspace, options, result);
 }
 
 namespace {
 
-void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+void lemkeAttempt(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace,
                   const LemkeOptions& options, double pivot_tolerance, LcpResult& res) {
+  if (options.product_form && lemkeRun(M, q, workspace, options, pivot_tolerance, true, res)) return;
+  const int spent = options.product_form ? res.pivots : 0;
+  lemkeRun(M, q, workspace, options, pivot_tolerance, false, res);
+  res.pivots += spent;
+}
+
+bool lemkeRun(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace, const LemkeOptions& options,
+              double pivot_tolerance, bool product, LcpResult& res) {
   const Index n = q.size();
   LemkeSolver s{workspace, M, q, options, pivot_tolerance, n, static_cast<int>(2 * n)};
+  s.product = product;
   auto z = res.z.head(n);
   auto w = res.w.head(n);
-  s.scale = std::max(M.cwiseAbs().maxCoeff(), s.cover.maxCoeff());
+  s.scale = std::max(M.maxAbs(), s.cover.maxCoeff());
   s.setup();
   const int max_pivots = options.max_pivots > 0 ? options.max_pivots
                                                 : static_cast<int>(100 * n + 1000);
@@ -335,6 +481,7 @@ void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& work
     }
   }
   int leaving = workspace.basic_[static_cast<std::size_t>(r)];
+  if (product) s.column(n);
   s.pivot(r, n);
   int pivots = 1;
 
@@ -344,7 +491,9 @@ void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& work
   while (pivots < max_pivots) {
     const int entering = leaving < n ? static_cast<int>(leaving + n) : static_cast<int>(leaving - n);
     const Index c = -workspace.where_[static_cast<std::size_t>(entering)] - 1;
+    if (product) s.column(c);
     r = s.ratioTest(c);
+    if (s.overflow) break;
     if (r < 0) {
       // a degenerate ray met with z0 already at 0 still ends on a complementary solution
       const double z0_value = s.rhs[workspace.where_[static_cast<std::size_t>(s.z0)]];
@@ -368,6 +517,7 @@ void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& work
     }
     leaving = workspace.basic_[static_cast<std::size_t>(r)];
     s.pivot(r, c);
+    if (s.overflow) break;
     ++pivots;
     if (leaving == s.z0) {
       res.status = LcpStatus::Solved;
@@ -376,6 +526,7 @@ void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& work
     }
   }
   res.pivots = pivots;
+  if (s.overflow) return false;
 
   // polish the final basis, then check the answer against the original data
   if (res.status == LcpStatus::Solved) {
@@ -387,6 +538,7 @@ void lemkeAttempt(const MatrixView& M, const VectorView& q, LemkeWorkspace& work
     res.status = LcpStatus::NumericalFailure;
     res.message = "final basis fails the residual check (ill-conditioned pivots)";
   }
+  return true;
 }
 
 }  // namespace

@@ -55,8 +55,12 @@ struct RowInfo {
 };
 
 /// Rows of one step for a fixed set of systems. Capacity-based: no allocation after construction.
+/// Jacobians are stored row-major: a row (what producers write and the solver reads) is contiguous.
 class RowSet {
  public:
+  using RowMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  using RowBlock = Eigen::Block<RowMatrix, 1, Eigen::Dynamic, true>;
+
   /// `system_nv[s]`: velocity size of system s; `max_rows`: rows of every kind; `max_friction_rows`:
   /// rows that may carry a friction cone; `max_edges`: the largest friction_edges.
   /// \throws std::invalid_argument on 0 or more than 64 systems, a negative nv or bad capacities.
@@ -74,17 +78,17 @@ class RowSet {
   int add(const RowInfo& info);
   /// Row r's Jacobian block on system s (1 × nv_s), writable. Marks s as touched by r. For an invalid
   /// r (e.g. −1 from a dropped add()) it is a sink row past the capacity, read by nobody.
-  Eigen::Block<Eigen::MatrixXd, 1, Eigen::Dynamic, false> jacobian(int r, int s);
+  RowBlock jacobian(int r, int s);
   /// Tangent Jacobians of a friction row r on system s: t1 (1 × nv_s) and t2 (1 × nv_s), writable.
-  Eigen::Block<Eigen::MatrixXd, 1, Eigen::Dynamic, false> tangent(int r, int s, int which);
+  RowBlock tangent(int r, int s, int which);
 
   const RowInfo& info(int r) const { return info_[r]; }
   RowInfo& info(int r) { return info_[r]; }
   /// ((capacity + 1) × nv_s) Jacobians of system s; rows [0, size()) valid, untouched rows are zero
   /// (the last row is the sink).
-  const Eigen::MatrixXd& jacobians(int s) const { return J_[s]; }
+  const RowMatrix& jacobians(int s) const { return J_[s]; }
   /// Tangent Jacobians t1 / t2 of system s, indexed by friction slot (frictionSlot(r)).
-  const Eigen::MatrixXd& tangents(int s, int which) const { return which == 0 ? T1_[s] : T2_[s]; }
+  const RowMatrix& tangents(int s, int which) const { return which == 0 ? T1_[s] : T2_[s]; }
   /// Friction slot of row r (−1: frictionless).
   int frictionSlot(int r) const { return slot_[r]; }
   int numFrictionRows() const { return nf_; }
@@ -94,7 +98,7 @@ class RowSet {
 
  private:
   std::vector<RowInfo> info_;
-  std::vector<Eigen::MatrixXd> J_, T1_, T2_;
+  std::vector<RowMatrix> J_, T1_, T2_;
   std::vector<int> slot_;
   std::vector<std::uint64_t> touch_;
   int n_ = 0, nf_ = 0, max_edges_ = 4;

@@ -3,9 +3,14 @@
 /// \brief Lemke's complementary pivoting (thesis 3.1.2, Algorithm 4) with the
 /// lexicographic ratio test, so degenerate problems do not cycle.
 ///
-/// Works on w − M z − d z₀ = q. The tableau only stores the n+1 non-basic columns
-/// (n×(n+1), dense, column-major) and is updated in place by a rank-one exchange at each
-/// pivot; nothing is allocated once the workspace has the right size (the overload writing into a
+/// Works on w − M z − d z₀ = q. Two forms of the same pivoting rules (same path up to rounding):
+/// - product form (default): B⁻¹ is kept as the product of the pivots' elementary (eta) matrices;
+///   a pivot costs O(n·k) after k pivots (the entering column B⁻¹A_j, one column of M), so a
+///   path of a few tens of pivots on a large, mostly inactive problem costs little; when the eta
+///   file is full (about n pivots) the attempt restarts in the dense form;
+/// - dense: the tableau stores the n+1 non-basic columns (n×(n+1), column-major) and is updated
+///   in place by a rank-one exchange at each pivot, O(n²) per pivot.
+/// Both use the workspace's tableau buffer (etas in its columns); nothing is allocated once the workspace has the right size (the overload writing into a
 /// caller's LcpResult allocates nothing at all once it has run on size n). For a copositive-plus
 /// M (e.g. symmetric positive semidefinite) ray termination proves the LCP has no solution.
 #include <vector>
@@ -37,6 +42,11 @@ struct LemkeOptions {
   int refinement_steps = 2;
   /// A final answer is reported Solved only if both relative residuals are ≤ this.
   double check_tolerance = 1e-9;
+  /// Product form of B⁻¹ (eta file) instead of the dense tableau (see the file comment).
+  bool product_form = true;
+  /// Product form: at most this many etas before the restart in the dense form (0: as many as the
+  /// workspace's n×(n+1) buffer holds, ≈ n).
+  int max_etas = 0;
 };
 
 /// Pre-sized storage for solveLemke. Its buffers only grow: reserve(capacity) once and every later
@@ -56,7 +66,8 @@ class LemkeWorkspace {
   Index n_ = -1;
   Index capacity_ = -1;
   // buffers are capacity-sized; the solver uses their leading n (n+1) rows/columns
-  Eigen::MatrixXd tableau_;  // n×(n+1), B⁻¹ times the non-basic columns of [I, −M, −d]
+  Eigen::MatrixXd tableau_;  // n×(n+1), B⁻¹ times the non-basic columns of [I, −M, −d]; product
+                             // form: eta columns from the left, B⁻¹ rows of tied rows from the right
   Eigen::VectorXd rhs_;      // n, B⁻¹ q: values of the basic variables
   Eigen::VectorXd col_;      // n, pivot column copy
   Eigen::VectorXd row_;      // n+1, pivot row copy
@@ -68,7 +79,23 @@ class LemkeWorkspace {
   std::vector<int> where_;     // 2n+1, row (≥ 0) or −(column+1) of each variable
   std::vector<int> ties_;      // candidate rows of the ratio test
   std::vector<int> keep_;      // scratch for the lexicographic filter
+  std::vector<int> eta_row_;   // product form: pivot row of each eta column
+  std::vector<int> tie_col_;   // product form: tableau column holding row i's B⁻¹ row (−1: none)
   LcpResult retry_;            // result of a retry run (the in-place solve swaps it in)
+};
+
+/// M known by its action, for problems whose M is a product (e.g. a Delassus matrix R b⁻¹ Rᵀ) that
+/// need not be formed: the product form only reads the columns of the variables that enter the basis.
+class LcpMatrixOperator {
+ public:
+  virtual ~LcpMatrixOperator() = default;
+  virtual Index size() const = 0;
+  /// out (n entries) = column j of M.
+  virtual void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const = 0;
+  /// out (n entries) = M z.
+  virtual void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const = 0;
+  /// max |M_ij| (the pivot tolerance's scale).
+  virtual double maxAbs() const = 0;
 };
 
 /// Solves 0 ≤ M z + q ⊥ z ≥ 0 (M n×n, q n) by Lemke's method.
@@ -88,6 +115,11 @@ LcpStatus solveLemke(const LcpProblem& problem, LemkeWorkspace& workspace, const
 /// least n entries (result.reserve(capacity); otherwise Invalid). No heap allocation once
 /// workspace.reserve(capacity) and result.reserve(capacity) have run, for every n ≤ capacity.
 LcpStatus solveLemke(const MatrixView& M, const VectorView& q, LemkeWorkspace& workspace,
+                     const LemkeOptions& options, LcpResult& result);
+/// The capacity path with M given by an operator (same contract). M's entries are not checked for
+/// NaN/Inf (the caller's); q is. The dense form (product_form off, or a full eta file) reads every
+/// column of M.
+LcpStatus solveLemke(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace,
                      const LemkeOptions& options, LcpResult& result);
 
 }  // namespace mannequin::lcp
