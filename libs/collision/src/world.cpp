@@ -443,8 +443,10 @@ void CollisionWorld::query(std::uint64_t step, ContactSet& out) {
       c.point_b = bMo.act(pb - B.margin * n);
       out.contacts.push_back(c);
     }
-    std::stable_sort(out.contacts.begin() + static_cast<std::ptrdiff_t>(first), out.contacts.end(),
-                     [](const Contact& u, const Contact& v) { return u.feature < v.feature; });
+    // by feature, stable (insertion sort: a pair has a few points, and std::stable_sort allocates)
+    for (std::size_t i = first + 1; i < out.contacts.size(); ++i)
+      for (std::size_t j = i; j > first && out.contacts[j].feature < out.contacts[j - 1].feature; --j)
+        std::swap(out.contacts[j], out.contacts[j - 1]);
   }
   out.stats.triangles_tested = I.scratch.triangles_tested;
 }
