@@ -26,7 +26,7 @@ std::string resolvePath(const ConfigNode& node) {
 void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
   ph.allowOnly({"enabled", "gravity", "scene", "segment_margin", "segment_material", "self_collision", "query_period_steps", "activation_distance",
                 "calibration_clearance", "friction_edges", "recovery_speed", "max_rows", "balance_rows",
-                "foot_contact_tolerance", "object_time_constant"});
+                "foot_contact_tolerance", "object_time_constant", "balance_ellipse"});
   p.enabled = ph.get("enabled", p.enabled);
   if (auto g = ph.find("gravity")) p.gravity = g->vec3();
   if (auto sc = ph.find("scene")) {
@@ -54,6 +54,7 @@ void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
   p.solver.max_rows = ph.get("max_rows", p.solver.max_rows);
   if (p.solver.max_rows < 1 || p.solver.max_rows > 100000) ph["max_rows"].fail("must be in [1, 100000]");
   p.balance_rows = ph.get("balance_rows", p.balance_rows);
+  if (auto be = ph.find("balance_ellipse")) p.balance.inscribed = be->choice({"enclosing", "inscribed"}) == 1;
   p.foot_contact_tolerance = ph.getIn("foot_contact_tolerance", p.foot_contact_tolerance, 0.0, 0.1);
   p.object_time_constant = ph.getIn("object_time_constant", p.object_time_constant, 1e-4, 10.0);
 }
