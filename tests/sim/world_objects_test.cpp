@@ -15,16 +15,14 @@
 #include "mannequin/math/so3.hpp"
 #include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/sim/world.hpp"
+#include "../constraints/male50_fixture.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
 using namespace mannequin;
 using namespace mannequin::sim;
 
 namespace {
-const skeleton::Model& male50() {
-  static const skeleton::Model m = skeleton::buildMannequin(skeleton::loadMannequinSpec("configs/mannequins/male_50th.yaml"));
-  return m;
-}
+using mannequin::testing_fixture::male50;
 
 const char* const kBodies[] = {"pelvis", "head", "hand_l", "hand_r", "foot_l", "foot_r"};
 
