@@ -60,6 +60,27 @@ std::string xmlName(const std::string& s) {
   return out;
 }
 
+/// The joints in the order of the bodies in the document (depth first, children in index order):
+/// MuJoCo numbers its bodies, joints and qpos in this order.
+std::vector<int> documentOrder(const Model& model) {
+  std::vector<std::vector<int>> children(model.joints.size());
+  std::vector<int> todo;
+  for (std::size_t j = model.joints.size(); j-- > 0;) {
+    const int p = model.joints[j].parent;
+    if (p < 0) todo.push_back(static_cast<int>(j));
+    else children[static_cast<std::size_t>(p)].push_back(static_cast<int>(j));
+  }
+  std::vector<int> order;
+  while (!todo.empty()) {
+    const int j = todo.back();
+    todo.pop_back();
+    order.push_back(j);
+    const std::vector<int>& c = children[static_cast<std::size_t>(j)];  // in decreasing index order
+    todo.insert(todo.end(), c.begin(), c.end());
+  }
+  return order;
+}
+
 struct Writer {
   const Model& model;
   const MjcfOptions& opt;
@@ -187,7 +208,8 @@ std::vector<double> mjcfQpos(const Model& model, const VectorX& q) {
                                 "' has nq = " + std::to_string(model.nq));
   std::vector<double> out;
   out.reserve(static_cast<std::size_t>(model.nq) + 1 + model.joints.size());
-  for (const Joint& J : model.joints) {
+  for (int j : documentOrder(model)) {
+    const Joint& J = model.joints[static_cast<std::size_t>(j)];
     const double* x = q.data() + J.idx_q;
     switch (J.type) {
       case JointType::kFreeFlyer: {

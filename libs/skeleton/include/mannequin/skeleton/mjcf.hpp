@@ -48,7 +48,8 @@ struct MjcfOptions {
 /// \throws std::invalid_argument when the model cannot be exported (no joint, a non-finite value).
 std::string toMjcf(const Model& model, const MjcfOptions& options = {});
 
-/// MuJoCo's qpos for our configuration `q` of `model`: the free flyer as (position, quaternion w x y z)
+/// MuJoCo's qpos for our configuration `q` of `model`, in MuJoCo's order (the bodies' depth-first order
+/// in the document, children in joint index order; not always our q's order): the free flyer as (position, quaternion w x y z)
 /// of the root body in the world, each ball joint as a quaternion, each revolute angle as is;
 /// size nq + 1 (free flyer) + the number of ball joints. \throws std::invalid_argument on a size mismatch.
 std::vector<double> mjcfQpos(const Model& model, const VectorX& q);
