@@ -191,6 +191,12 @@ std::string toMjcf(const Model& model, const MjcfOptions& options) {
        std::to_string(model.segments.size()) + " segments, total mass " + num(model.totalMass()) + " kg -->\n";
   o += "  <compiler angle=\"radian\" inertiafromgeom=\"false\"/>\n";
   o += "  <option timestep=\"" + num(options.timestep) + "\" gravity=\"" + vec(options.gravity) + "\"/>\n";
+  if (options.nconmax > 0 || options.njmax > 0) {
+    o += "  <size";
+    if (options.nconmax > 0) o += " nconmax=\"" + std::to_string(options.nconmax) + "\"";
+    if (options.njmax > 0) o += " njmax=\"" + std::to_string(options.njmax) + "\"";
+    o += "/>\n";
+  }
   o += "  <worldbody>\n";
   if (options.floor)
     o += "    <geom name=\"floor\" type=\"plane\" size=\"0 0 1\" contype=\"1\" conaffinity=\"1\" condim=\"3\" friction=\"" +

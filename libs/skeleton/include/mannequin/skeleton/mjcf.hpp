@@ -40,6 +40,10 @@ struct MjcfOptions {
   /// massless_mass per such body.
   double massless_mass = 1e-6;
   double massless_inertia = 1e-9;
+  /// MuJoCo's preallocated contact and constraint buffers (<size nconmax njmax>; 0: MuJoCo's default,
+  /// 100 contacts in MuJoCo 2.2).
+  int nconmax = 0;
+  int njmax = 0;
   /// Raw XML inserted at the end of <worldbody> (static obstacles of a benchmark scene).
   std::string extra_worldbody;
 };
