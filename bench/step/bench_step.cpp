@@ -496,6 +496,8 @@ namespace {
 /// steps with a steady clock and reports: contacts (MuJoCo's d->ncon, mean), efc (its constraint rows),
 /// ours_contacts (our contact rows, mean), ours_us, mujoco_us and ratio = ours_us / mujoco_us.
 void mujocoSweep(benchmark::State& state, int target) {
+  // MuJoCo prints warnings on stdout (and appends them to MUJOCO_LOG.TXT): stderr keeps the JSON valid
+  mju_user_warning = [](const char* msg) { std::fprintf(stderr, "bench-step: MuJoCo warning: %s\n", msg); };
   const SweepSetup setup = sweepSetup(target);
   std::string spheres;
   for (const collision::BodySpec& b : setup.scene.bodies) {
