@@ -12,12 +12,13 @@
 #include <unistd.h>
 #include <fstream>
 #include <map>
+#include <random>
 #include <string>
 #include <vector>
 
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
-#include "test_models.hpp"
+#include "mannequin/math/so3.hpp"
 
 #ifdef MANNEQUIN_HAVE_MUJOCO
 #include <mujoco/mujoco.h>
@@ -118,6 +119,42 @@ void count(const Element& e, Counts& c) {
   for (const Element& ch : e.children) count(ch, c);
 }
 
+/// A random tree as test_models::makeRandomTree (free root, balls and revolutes with random placements
+/// and axes, a massive segment per joint, parents at random: the index order is not depth first), its
+/// names appended rather than concatenated (g++ 12 reports a false -Wrestrict on `"j" + to_string(i)`
+/// inlined here).
+Model randomTree(unsigned seed, int njoints) {
+  std::mt19937 g(seed);
+  std::normal_distribution<double> n;
+  std::uniform_real_distribution<double> u(0.1, 2.0);
+  auto v3 = [&] { return Vector3(n(g), n(g), n(g)); };
+  auto name = [](char c, int i) {
+    std::string s(1, c);
+    s.append(std::to_string(i));
+    return s;
+  };
+  Model m;
+  m.name = "random";
+  m.addJoint("root", JointType::kFreeFlyer, -1, SE3::Identity());
+  for (int i = 1; i < njoints; ++i) {
+    std::uniform_int_distribution<int> parent(0, i - 1);
+    const SE3 placement(mannequin::math::expSO3(v3()), 0.3 * v3());
+    m.addJoint(name('j', i), i % 3 == 0 ? JointType::kBall : JointType::kRevolute, parent(g), placement, v3());
+  }
+  for (int i = 0; i < njoints; ++i) {
+    Segment s;
+    s.name = name('s', i);
+    s.joint = i;
+    s.mass = u(g);
+    s.com = 0.2 * v3();
+    s.inertia = Matrix3::Identity() * 0.01;
+    s.capsule.b = 0.1 * v3();
+    s.capsule.radius = 0.02;
+    m.addSegment(s);
+  }
+  return m;
+}
+
 int massless(const Model& m) {
   int n = 0;
   for (std::size_t j = 0; j < m.joints.size(); ++j) {
@@ -161,7 +198,7 @@ TEST(Mjcf, MannequinIsWellFormedWithTheModelsJointsAndMass) {
 }
 
 TEST(Mjcf, RandomTreeNestsBodiesAsTheJointTree) {
-  const Model model = test_models::makeRandomTree(7, 15);
+  const Model model = randomTree(7, 15);
   std::string error;
   const Element doc = parseXml(toMjcf(model), error);
   ASSERT_EQ(error, "");
@@ -266,7 +303,7 @@ TEST(MjcfMujoco, LoadsWithOurSizesMassAndForwardKinematics) {
 TEST(MjcfMujoco, RandomTreeForwardKinematicsMatchesAtRandomConfigurations) {
   // rotated placements, random axes, a tree whose index order is not depth first: mjcfQpos's order
   for (unsigned seed : {3u, 11u}) {
-    const Model model = test_models::makeRandomTree(seed, 15);
+    const Model model = randomTree(seed, 15);
     std::string error;
     mjModel* m = loadMujoco(toMjcf(model), error);
     ASSERT_NE(m, nullptr) << error;
