@@ -36,6 +36,17 @@
 #include "mannequin/math/so3.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
+#include "mannequin/skeleton/mjcf.hpp"
+
+#ifdef MANNEQUIN_HAVE_MUJOCO
+#include <mujoco/mujoco.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#endif
 
 using namespace mannequin;
 using namespace mannequin::sim;
@@ -283,13 +294,23 @@ void measure(benchmark::State& state, PhysicsRun& run, const std::vector<math::S
 
 constexpr double kSegmentMargin = 0.005;  // PhysicsConfig's default
 
-void contactSweep(benchmark::State& state, int target) {
-  const skeleton::Model model =
-      skeleton::buildMannequin(skeleton::loadMannequinSpec(mannequin::bench::dataFile("configs/mannequins/male_50th.yaml")));
-  skeleton::Data d(model);
-  skeleton::forwardKinematics(model, d, skeleton::standingConfiguration(model));
-  // F: the feet's floor contacts of the standing pose (a query of the floor alone)
+/// The contact sweep's set-up for `target` contact rows (see the file comment): the standing
+/// male_50th, its floor contacts F and the scene (floor and target − F spheres).
+struct SweepSetup {
+  skeleton::Model model;
+  skeleton::VectorX q;
+  SceneSpec scene;
   int floor_contacts = 0;
+};
+
+SweepSetup sweepSetup(int target) {
+  SweepSetup s;
+  s.model = skeleton::buildMannequin(skeleton::loadMannequinSpec(mannequin::bench::dataFile("configs/mannequins/male_50th.yaml")));
+  const skeleton::Model& model = s.model;
+  s.q = skeleton::standingConfiguration(model);
+  skeleton::Data d(model);
+  skeleton::forwardKinematics(model, d, s.q);
+  // F: the feet's floor contacts of the standing pose (a query of the floor alone)
   if (target > 0) {
     collision::CollisionWorld cw;
     cw.addScene(ringedScene(model, d, true, 0, kSegmentMargin));
@@ -300,11 +321,19 @@ void contactSweep(benchmark::State& state, int target) {
     cw.updateMannequin(cw.addMannequin(model, mo), d);
     collision::ContactSet set;
     cw.query(0, set);
-    floor_contacts = static_cast<int>(set.contacts.size());
+    s.floor_contacts = static_cast<int>(set.contacts.size());
   }
-  PhysicsRun run = physicsWorld(ringedScene(model, d, target > 0, std::max(0, target - floor_contacts), kSegmentMargin),
-                                "configs/control/mocap.yaml", nullptr,
-                                math::Vector3::Zero());  // contacts:0 has no floor to stand on
+  s.scene = ringedScene(model, d, target > 0, std::max(0, target - s.floor_contacts), kSegmentMargin);
+  return s;
+}
+
+PhysicsRun sweepWorld(const SweepSetup& s) {
+  return physicsWorld(s.scene, "configs/control/mocap.yaml", nullptr,
+                      math::Vector3::Zero());  // contacts:0 has no floor to stand on
+}
+
+void contactSweep(benchmark::State& state, int target) {
+  PhysicsRun run = sweepWorld(sweepSetup(target));
   const std::vector<math::SE3> calibration = run.targets;
   measure(state, run, calibration);
 }
@@ -450,6 +479,114 @@ void handsOnTable(benchmark::State& state) {
 }
 
 }  // namespace
+
+#ifdef MANNEQUIN_HAVE_MUJOCO
+namespace {
+
+/// The contact sweep's scene in MuJoCo: the mannequin exported by skeleton::toMjcf (same joints, masses,
+/// capsules, box feet; gravity 0 as the sweep), standing (mjcfQpos of the standing configuration), the
+/// floor and the same spheres as static geoms, with margin = 2 cm (our activation distance): MuJoCo
+/// keeps the contacts within 2 cm, all in its solver (no gap). Spheres frictionless (condim 1, priority 1
+/// so that their condim wins over the mannequin's 3) as ours; the floor with friction 0.5 (pyramidal
+/// cones: 4 rows per contact, MuJoCo's default). MuJoCo's defaults otherwise: Euler, Newton solver. No
+/// controller: MuJoCo's soft contacts push from the margin on (ours: λ = 0 until touching) and nothing
+/// holds the mannequin, so it would drift out of range; each step starts from the standing state (qpos
+/// reset, qvel 0: a copy of 51 + 43 doubles, timed with the step) to keep the pose's contact count.
+/// Times mj_step; after the run, times our World (the BM_PhysicsStep case of the same N) over as many
+/// steps with a steady clock and reports: contacts (MuJoCo's d->ncon, mean), efc (its constraint rows),
+/// ours_contacts (our contact rows, mean), ours_us, mujoco_us and ratio = ours_us / mujoco_us.
+void mujocoSweep(benchmark::State& state, int target) {
+  // MuJoCo prints warnings on stdout (and appends them to MUJOCO_LOG.TXT): stderr keeps the JSON valid
+  mju_user_warning = [](const char* msg) { std::fprintf(stderr, "bench-step: MuJoCo warning: %s\n", msg); };
+  const SweepSetup setup = sweepSetup(target);
+  std::string spheres;
+  for (const collision::BodySpec& b : setup.scene.bodies) {
+    if (b.shapes.empty() || b.shapes[0].shape.type != collision::ShapeType::kSphere) continue;
+    char buf[256];
+    std::snprintf(buf, sizeof buf,
+                  "    <geom name=\"%s\" type=\"sphere\" size=\"%.9g\" pos=\"%.12g %.12g %.12g\" contype=\"1\" "
+                  "conaffinity=\"1\" condim=\"1\" priority=\"1\" margin=\"0.02\"/>\n",
+                  b.name.c_str(), b.shapes[0].shape.radius, b.pose.p.x(), b.pose.p.y(), b.pose.p.z());
+    spheres += buf;
+  }
+  skeleton::MjcfOptions opt;
+  opt.gravity = math::Vector3::Zero();
+  opt.floor = false;  // written below with the activation margin
+  opt.nconmax = 1000;
+  opt.njmax = 4000;
+  if (target > 0)
+    spheres += "    <geom name=\"floor\" type=\"plane\" size=\"0 0 1\" contype=\"1\" conaffinity=\"1\" condim=\"3\" "
+               "friction=\"0.5 0.005 0.0001\" margin=\"0.02\"/>\n";
+  opt.extra_worldbody = spheres;
+  const std::string xml = skeleton::toMjcf(setup.model, opt);
+  const std::string path = (std::filesystem::temp_directory_path() /
+                            ("bench_step_mujoco_" + std::to_string(::getpid()) + "_" + std::to_string(target) + ".xml"))
+                               .string();
+  { std::ofstream(path) << xml; }
+  char err[1000] = "";
+  mjModel* m = mj_loadXML(path.c_str(), nullptr, err, sizeof err);
+  std::filesystem::remove(path);
+  if (m == nullptr) {
+    state.SkipWithError((std::string("MuJoCo refuses the exported model: ") + err).c_str());
+    return;
+  }
+  mjData* d = mj_makeData(m);
+  const std::vector<double> qpos = skeleton::mjcfQpos(setup.model, setup.q);
+  for (int i = 0; i < m->nq; ++i) d->qpos[i] = qpos[static_cast<std::size_t>(i)];
+  const auto reset = [&] {
+    for (int i = 0; i < m->nq; ++i) d->qpos[i] = qpos[static_cast<std::size_t>(i)];
+    for (int i = 0; i < m->nv; ++i) d->qvel[i] = 0.0;
+  };
+  for (int i = 0; i < 100; ++i) {  // warm-up, as ours
+    reset();
+    mj_step(m, d);
+  }
+  double ncon = 0, nefc = 0;
+  long n = 0;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (auto _ : state) {
+    reset();
+    mj_step(m, d);
+    ncon += d->ncon;
+    nefc += d->nefc;
+    ++n;
+  }
+  const double mujoco_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  mj_deleteData(d);
+  mj_deleteModel(m);
+  // ours, the same N, as many steps (at least 200)
+  PhysicsRun run = sweepWorld(setup);
+  const std::vector<math::SE3> calibration = run.targets;
+  Driver driver(run, calibration);
+  for (int i = 0; i < 100; ++i) driver.step();
+  const long ours_n = std::max(200L, n);
+  double ours_contacts = 0;
+  const auto t1 = std::chrono::steady_clock::now();
+  for (long i = 0; i < ours_n; ++i) {
+    benchmark::DoNotOptimize(driver.step());
+    ours_contacts += run.world->diagnostics().contacts;
+  }
+  const double ours_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count();
+  const double inv = n > 0 ? 1.0 / static_cast<double>(n) : 0.0;
+  state.counters["contacts"] = ncon * inv;
+  state.counters["efc"] = nefc * inv;
+  state.counters["ours_contacts"] = ours_contacts / static_cast<double>(ours_n);
+  state.counters["mujoco_us"] = 1e6 * mujoco_s * inv;
+  state.counters["ours_us"] = 1e6 * ours_s / static_cast<double>(ours_n);
+  state.counters["ratio"] = mujoco_s > 0 ? (ours_s / static_cast<double>(ours_n)) / (mujoco_s * inv) : 0.0;
+}
+
+}  // namespace
+
+static void registerMujocoSweep() {
+  for (int n = 0; n <= 300; n += (n < 280 ? 10 : 20)) {
+    benchmark::RegisterBenchmark(("BM_MujocoStep/contacts:" + std::to_string(n)).c_str(),
+                                 [n](benchmark::State& st) { mujocoSweep(st, n); })
+        ->Unit(benchmark::kMicrosecond);
+  }
+}
+static const int kMujocoRegistered = (registerMujocoSweep(), 0);
+#endif
 
 static void BM_PhysicsStep(benchmark::State& state, int contacts) { contactSweep(state, contacts); }
 static void BM_PhysicsStandingHandsOnTable(benchmark::State& state) { handsOnTable(state); }
