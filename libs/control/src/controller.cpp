@@ -376,7 +376,20 @@ void Controller::assembleFriction() {
     }
   }
   b_.triangularView<Eigen::StrictlyUpper>() = b_.transpose();
-  llt_.compute(b_);
+  llt_.computeUnblocked(b_);
+}
+
+void Controller::FrictionLLT::computeUnblocked(const MatrixX& a) {
+  // as Eigen::LLT::compute (same members: the factor, its L1 norm for rcond(), the status) with
+  // Eigen's unblocked kernel; no allocation once m_matrix has the size
+  const Eigen::Index n = a.rows();
+  m_matrix = a;
+  m_l1_norm = 0.0;
+  for (Eigen::Index col = 0; col < n; ++col)
+    m_l1_norm = std::max(m_l1_norm, m_matrix.col(col).tail(n - col).lpNorm<1>() + m_matrix.row(col).head(col).lpNorm<1>());
+  m_isInitialized = true;
+  const Eigen::Index failed = Eigen::internal::llt_inplace<double, Eigen::Lower>::unblocked(m_matrix);
+  m_info = failed == -1 ? Eigen::Success : Eigen::NumericalIssue;
 }
 
 void Controller::gramOfTasks() {
