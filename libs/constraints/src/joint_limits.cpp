@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "mannequin/math/so3.hpp"
@@ -155,6 +156,60 @@ JointLimitRows::JointLimitRows(const control::Controller& controller, int system
   ball_rows_.reserve(3 * balls_.size());
   box_rows_.assign(2 * boxes_.size(), 0);
   ball_has_rows_.assign(balls_.size(), 0);
+  ball_R_.assign(balls_.size(), Eigen::Matrix3d::Identity());
+  ball_d_.assign(balls_.size(), BallLimitDistances{});
+  ball_eval_.assign(balls_.size(), 0);
+  // The bounds of farFromLimits(), by sampling the swing directions (720, as BallLimit::maxSwing) with
+  // a safety factor. Along a ray u of the ellipse, h(ρu) − 1 = A(ρ − ρ_b)(ρ − ρ₂) with ρ₂ < 0 < ρ_b, so
+  // d_s = κ(1 − h) = (ρ_b − ρ)(ρ − ρ₂)/(ρ_b − ρ₂) ≥ m(u)(ρ_b − ρ) on [0, ρ_b], m(u) = −ρ₂/(ρ_b − ρ₂);
+  // κ(u) = 1/(A(ρ_b − ρ₂)), and inside the ellipse |dh/ds| = 2|Q(s − c)| ≤ 2/min(a, b).
+  for (const int ji : balls_) {
+    const skeleton::BallLimit& l = model.joints[static_cast<std::size_t>(ji)].ball_limit;
+    constexpr int kSamples = 720;
+    const double cx = l.swing_cx / l.swing_a, cy = l.swing_cy / l.swing_b;
+    const double C = cx * cx + cy * cy - 1.0;
+    BallBound bb;
+    bb.rho_min = std::numeric_limits<double>::infinity();
+    bb.slope_min = 1.0;
+    double kappa_max = 0.0;
+    for (int i = 0; i < kSamples; ++i) {
+      const double phi = 2.0 * 3.14159265358979323846 * i / kSamples;
+      const double ux = std::cos(phi) / l.swing_a, uy = std::sin(phi) / l.swing_b;
+      const double A = ux * ux + uy * uy, B = ux * cx + uy * cy;
+      const double root = std::sqrt(std::max(0.0, B * B - A * C));
+      const double rb = (B + root) / A, r2 = (B - root) / A;
+      bb.rho_min = std::min(bb.rho_min, rb);
+      bb.slope_min = std::min(bb.slope_min, -r2 / (rb - r2));
+      kappa_max = std::max(kappa_max, 1.0 / (A * (rb - r2)));
+    }
+    bb.rho_min *= 0.98;
+    bb.slope_min *= 0.9;
+    bb.grad_max = 1.1 * kappa_max * 2.0 / std::min(l.swing_a, l.swing_b);
+    bb.twist_min = std::min(-l.twist_lower, l.twist_upper);
+    if (!(C < 0.0) || !std::isfinite(bb.rho_min) || !(bb.slope_min > 0.0) || !std::isfinite(bb.grad_max))
+      bb.rho_min = -1.0;  // no usable bound: never skip
+    ball_bound_.push_back(bb);
+  }
+}
+
+bool JointLimitRows::farFromLimits(std::size_t bi, double theta, double speed, double dt, double margin) const {
+  // θ bounds the rotation angle of R, hence its swing angle θ_s and |θ_t| (R = R_s R_t about t: as
+  // quaternions, cos(θ/2) = cos(θ_s/2) cos(θ_t/2)); the rows' rates are bounded by |ds/dω| ≤ f + g
+  // (swing_twist.cpp, (61): f, g grow with θ_s) and |dθ_t/dω| ≤ 1 + |Jr| |ds/dω| ≤ 1 + f + g
+  const BallBound& b = ball_bound_[bi];
+  if (!(theta >= 0.0) || !(theta < b.rho_min) || !(theta < b.twist_min) || !std::isfinite(speed)) return false;
+  double g, f;
+  if (theta < 1e-3) {
+    g = 1.0 + theta * theta / 6.0;
+    f = 1.0 / 3.0 + 2.0 * theta * theta / 15.0;
+  } else {
+    const double s = std::sin(theta), c = std::cos(theta);
+    g = theta / s;
+    f = (s - theta * c) / (s * s * s);
+  }
+  const double step = dt * speed;
+  return b.slope_min * (b.rho_min - theta) - step * b.grad_max * (f + g) >= margin &&
+         b.twist_min - theta - step * (1.0 + f + g) >= margin;
 }
 
 int JointLimitRows::activeCount() const {
@@ -209,19 +264,19 @@ void JointLimitRows::addBall(int id, RowSet& rows, std::size_t bi, const BallLim
   if (d.singular) {
     const int r = add(id, rows, RowSource::kSwing, j.idx_q, false, d.swing, j.idx_v, 3, d.swing_jacobian.data(),
                       correction ? correction[0] : 0.0);
-    ball_rows_.push_back({r, ji, 0, true, d.swing, 0.0});
+    ball_rows_.push_back({r, ji, static_cast<int>(bi), 0, true, d.swing, 0.0});
     return;
   }
   const Eigen::RowVector3d neg = -d.twist_jacobian;
   int r = add(id, rows, RowSource::kSwing, j.idx_q, false, d.swing, j.idx_v, 3, d.swing_jacobian.data(),
               correction ? correction[0] : 0.0);
-  ball_rows_.push_back({r, ji, 0, false, d.swing, d.swing_scale});
+  ball_rows_.push_back({r, ji, static_cast<int>(bi), 0, false, d.swing, d.swing_scale});
   r = add(id, rows, RowSource::kTwist, j.idx_q, false, d.twist_lower, j.idx_v, 3, d.twist_jacobian.data(),
           correction ? correction[1] : 0.0);
-  ball_rows_.push_back({r, ji, 1, false, d.twist_lower, 0.0});
+  ball_rows_.push_back({r, ji, static_cast<int>(bi), 1, false, d.twist_lower, 0.0});
   r = add(id, rows, RowSource::kTwist, j.idx_q, true, d.twist_upper, j.idx_v, 3, neg.data(),
           correction ? correction[2] : 0.0);
-  ball_rows_.push_back({r, ji, 2, false, d.twist_upper, 0.0});
+  ball_rows_.push_back({r, ji, static_cast<int>(bi), 2, false, d.twist_upper, 0.0});
 }
 
 void JointLimitRows::addRows(int id, double dt, RowSet& rows) {
@@ -243,9 +298,18 @@ void JointLimitRows::addRows(int id, double dt, RowSet& rows) {
     if (std::isfinite(b.lower) && candidate(dt, lo_d, b.v, nc, row.data())) addBox(id, rows, bi, false, 0.0);
     if (std::isfinite(b.upper) && candidate(dt, hi_d, b.v, nc, neg.data())) addBox(id, rows, bi, true, 0.0);
   }
+  const Eigen::VectorXd& qf = ctl_->qdotFree();
   for (std::size_t bi = 0; bi < balls_.size(); ++bi) {
     const skeleton::Joint& j = model.joints[static_cast<std::size_t>(balls_[bi])];
-    const BallLimitDistances d = ballLimitDistances(j.ball_limit, math::expSO3(q.segment<3>(j.idx_q)));
+    // far inside the cone and the twist range at q_k and after the free step: no candidate, no
+    // excess (farFromLimits bounds the rows' distances and rates), so no decomposition
+    ball_eval_[bi] = 0;
+    if (farFromLimits(bi, q.segment<3>(j.idx_q).norm(), qf.segment<3>(j.idx_v).norm(), dt, options_.activation))
+      continue;
+    ball_R_[bi] = math::expSO3(q.segment<3>(j.idx_q));
+    ball_d_[bi] = ballLimitDistances(j.ball_limit, ball_R_[bi]);
+    ball_eval_[bi] = 1;
+    const BallLimitDistances& d = ball_d_[bi];
     worst_excess_ = std::max(worst_excess_, d.swing_excess);
     if (!d.singular) worst_excess_ = std::max({worst_excess_, -d.twist_lower, -d.twist_upper});
     // near swing π only the radial swing row (the twist is undefined there); else all three rows
@@ -276,7 +340,7 @@ bool JointLimitRows::refine(int id, double dt, RowSet& rows, const std::vector<E
     const skeleton::BallLimit& l = j.ball_limit;
     const Eigen::Vector3d w = v.segment<3>(j.idx_v);
     if (b.joint != joint) {  // where the step takes the ball: R_k exp(δt ω), as the controller integrates
-      next = ballLimitDistances(l, math::expSO3(q.segment<3>(j.idx_q)) * math::expSO3(dt * w));
+      next = ballLimitDistances(l, ball_R_[static_cast<std::size_t>(b.ball)] * math::expSO3(dt * w));
       joint = b.joint;
     }
     double d_next;
@@ -310,10 +374,16 @@ bool JointLimitRows::refine(int id, double dt, RowSet& rows, const std::vector<E
     const skeleton::Joint& j = model.joints[static_cast<std::size_t>(balls_[bi])];
     const skeleton::BallLimit& l = j.ball_limit;
     const Eigen::Vector3d w = v.segment<3>(j.idx_v);
-    const Eigen::Matrix3d R = math::expSO3(q.segment<3>(j.idx_q));
-    const BallLimitDistances n1 = ballLimitDistances(l, R * math::expSO3(dt * w));
+    // R_k exp(δt ω) turns by at most |q_ball| + δt|ω|: inside the cone and the twist range when that is
+    if (farFromLimits(bi, q.segment<3>(j.idx_q).norm() + dt * w.norm(), 0.0, dt, 1e-9)) continue;
+    if (!ball_eval_[bi]) {
+      ball_R_[bi] = math::expSO3(q.segment<3>(j.idx_q));
+      ball_d_[bi] = ballLimitDistances(l, ball_R_[bi]);
+      ball_eval_[bi] = 1;
+    }
+    const BallLimitDistances n1 = ballLimitDistances(l, ball_R_[bi] * math::expSO3(dt * w));
     if (n1.swing_excess <= 0.0 && (n1.singular || (n1.twist_lower >= 0.0 && n1.twist_upper >= 0.0))) continue;
-    const BallLimitDistances d = ballLimitDistances(l, R);
+    const BallLimitDistances& d = ball_d_[bi];
     double c[3];
     c[0] = (d.singular ? ellipseRadius(l, n1.st.swing_dir) - n1.st.swing_angle
                        : d.swing_scale * (1.0 - ellipseLevel(l, n1.st.swing))) -

@@ -284,12 +284,29 @@ const SolveReport& ConstraintSolver::solve(double dt) {
       }
       auto X = im.X[us].leftCols(nF);
       X = Rt;
-      // in panels of kPanel columns: Eigen's blocked kernels then keep their packing buffers on the
-      // stack (under EIGEN_STACK_ALLOCATION_LIMIT) instead of allocating them for large n
-      const auto L = systems_[us]->frictionLLT().matrixL();
-      for (int c0 = 0; c0 < nF; c0 += kPanel) {
-        auto Xc = X.middleCols(c0, std::min(kPanel, nF - c0));
-        L.solveInPlace(Xc);  // L⁻¹ Rᵀ
+      // L⁻¹ Rᵀ. Few columns (the usual step: feet, limits): forward substitution per column, an axpy
+      // of L's column per nonzero (at nv ≈ 40 Eigen's blocked triangular solve spends most of its
+      // time packing). Many: in panels of kPanel columns, Eigen's blocked kernels then keep their
+      // packing buffers on the stack (under EIGEN_STACK_ALLOCATION_LIMIT) instead of allocating them
+      const Eigen::LLT<Eigen::MatrixXd>& llt = systems_[us]->frictionLLT();
+      if (nF <= kPanel) {
+        const Eigen::MatrixXd& L = llt.matrixLLT();
+        const Eigen::Index nvs = L.rows();
+        for (int c = 0; c < nF; ++c) {
+          auto x = X.col(c);
+          for (Eigen::Index j = 0; j < nvs; ++j) {
+            if (x(j) == 0.0) continue;  // the leading zeros of a row on a limb's columns stay zero
+            x(j) /= L(j, j);
+            const Eigen::Index below = nvs - j - 1;
+            x.tail(below) -= x(j) * L.col(j).tail(below);
+          }
+        }
+      } else {
+        const auto L = llt.matrixL();
+        for (int c0 = 0; c0 < nF; c0 += kPanel) {
+          auto Xc = X.middleCols(c0, std::min(kPanel, nF - c0));
+          L.solveInPlace(Xc);
+        }
       }
       diag += X.colwise().squaredNorm().transpose();
       q.head(nF).noalias() += Rt.transpose() * systems_[us]->qdotFree();

@@ -153,6 +153,19 @@ void Controller::build(const VectorX& q0) {
   for (size_t l = 0; l < level_begin_.size(); ++l)
     level_projectors_.emplace_back(6 * level_begin_[l], nv_, c.projector, c.rank_tolerance);
   internal_projector_ = WeightedNullSpace(rows_, nv_, c.projector, c.rank_tolerance);
+  frame_pairs_.clear();
+  for (int a = 0; a < nf; ++a)
+    for (int b = 0; b < nf; ++b) {
+      if (frame_row_[a] < frame_row_[b]) continue;
+      FramePair fp;
+      fp.frame_a = a;
+      fp.frame_b = b;
+      for (int col : support_cols_[a])
+        if (std::find(support_cols_[b].begin(), support_cols_[b].end(), col) != support_cols_[b].end())
+          fp.cols.push_back(col);
+      if (!fp.cols.empty()) frame_pairs_.push_back(std::move(fp));
+    }
+  gram_.setZero(rows_, rows_);
 
   // buffers
   for (VectorX* v : {&qdot_, &qdot_prev_, &qdot_free_, &dq_int_, &gamma0_, &gamma_task_, &gamma_level_, &gamma_int_,
@@ -346,12 +359,49 @@ void Controller::couplingTerms() {
 }
 
 void Controller::assembleFriction() {
-  // b = b_a + Σ Jᵀ B J (2.17), lower triangle by a rank update, then mirrored
+  // b = b_a + Σ Jᵀ B J (2.17): per frame over its support columns only (JB_ is zero elsewhere), the
+  // lower triangle, then mirrored
   b_.setZero();
   b_.diagonal() = b_a_;
-  b_.selfadjointView<Eigen::Lower>().rankUpdate(JB_.transpose());
+  for (int i = 0; i < numFrames(); ++i) {
+    if (!frames_[i].enabled) continue;
+    const int r = frame_row_[i];
+    const std::vector<int>& cols = support_cols_[i];
+    for (std::size_t a = 0; a < cols.size(); ++a) {
+      const auto ja = JB_.block<6, 1>(r, cols[a]);
+      for (std::size_t b = 0; b <= a; ++b) {
+        const double v = ja.dot(JB_.block<6, 1>(r, cols[b]));
+        b_(std::max(cols[a], cols[b]), std::min(cols[a], cols[b])) += v;
+      }
+    }
+  }
   b_.triangularView<Eigen::StrictlyUpper>() = b_.transpose();
-  llt_.compute(b_);
+  llt_.computeUnblocked(b_);
+}
+
+void Controller::FrictionLLT::computeUnblocked(const MatrixX& a) {
+  // as Eigen::LLT::compute (same members: the factor, its L1 norm for rcond(), the status) with
+  // Eigen's unblocked kernel; no allocation once m_matrix has the size
+  const Eigen::Index n = a.rows();
+  m_matrix = a;
+  m_l1_norm = 0.0;
+  for (Eigen::Index col = 0; col < n; ++col)
+    m_l1_norm = std::max(m_l1_norm, m_matrix.col(col).tail(n - col).lpNorm<1>() + m_matrix.row(col).head(col).lpNorm<1>());
+  m_isInitialized = true;
+  const Eigen::Index failed = Eigen::internal::llt_inplace<double, Eigen::Lower>::unblocked(m_matrix);
+  m_info = failed == -1 ? Eigen::Success : Eigen::NumericalIssue;
+}
+
+void Controller::gramOfTasks() {
+  // G = J b_a⁻¹ Jᵀ, lower triangle, block by block over the columns both frames' rows reach
+  gram_.setZero();
+  for (const FramePair& fp : frame_pairs_) {
+    if (!frames_[fp.frame_a].enabled || !frames_[fp.frame_b].enabled) continue;
+    const int ra = frame_row_[fp.frame_a], rb = frame_row_[fp.frame_b];
+    Matrix6 block = Matrix6::Zero();
+    for (int col : fp.cols) block.noalias() += (b_a_inv_(col) * J_.block<6, 1>(ra, col)) * J_.block<6, 1>(rb, col).transpose();
+    gram_.block<6, 6>(ra, rb) = block;
+  }
 }
 
 StepStatus Controller::computeFreeMotion() {
@@ -369,6 +419,7 @@ StepStatus Controller::computeFreeMotion() {
 
   // task torques by priority level (2.78–2.80): Γ = Γ_0 + Σ_k Π_prev(k)ᵀ Γ_k
   gamma_task_.setZero();
+  bool gram_ready = false;  // gram_ of this step's J_
   const int nl = static_cast<int>(level_begin_.size());
   for (int l = 0; l < nl; ++l) {
     const int k0 = level_begin_[l];
@@ -379,7 +430,9 @@ StepStatus Controller::computeFreeMotion() {
       gamma_level_.noalias() += J_.middleRows<6>(frame_row_[i]).transpose() * wrench_ff_[i];
     }
     if (l > 0) {
-      level_projectors_[l].compute(J_.topRows(6 * k0), b_a_inv_);
+      if (!gram_ready) gramOfTasks();
+      gram_ready = true;
+      level_projectors_[l].computeWithGram(J_.topRows(6 * k0), b_a_inv_, gram_.topLeftCorner(6 * k0, 6 * k0));
       level_projectors_[l].projectTorque(gamma_level_, gamma_level_);
     }
     gamma_task_ += gamma_level_;
@@ -392,7 +445,9 @@ StepStatus Controller::computeFreeMotion() {
     const double alpha = observer_.alpha();
     gamma0_ = alpha * (k_int_.cwiseProduct(dq_int_) - b_int_.cwiseProduct(qdot_prev_));
     if (config_.internal.projection == InternalProjection::kDynamic && rows_ > 0) {
-      internal_projector_.compute(J_, b_a_inv_);
+      if (!gram_ready) gramOfTasks();
+      gram_ready = true;
+      internal_projector_.computeWithGram(J_, b_a_inv_, gram_);
       internal_projector_.projectTorque(gamma0_, gamma_level_);
     } else {
       gamma_level_ = gamma0_;

@@ -42,12 +42,7 @@ void WeightedNullSpace::compute(const Eigen::Ref<const MatrixX>& J, const Vector
     // G = J W⁻¹ Jᵀ (lower triangle), pivoted LDLᵀ; rank = pivots above tol · max pivot
     G_.setZero();
     G_.selfadjointView<Eigen::Lower>().rankUpdate(Js_);
-    ldlt_.compute(G_);
-    const auto& D = ldlt_.vectorD();
-    const double dmax = D.size() > 0 ? D.cwiseAbs().maxCoeff() : 0.0;
-    const double cut = tol_ * dmax;
-    for (Eigen::Index i = 0; i < D.size(); ++i)
-      if (D(i) > cut && dmax > 0) ++rank_;
+    factorGram();
   } else {
     svd_.compute(Js_, Eigen::ComputeThinV);
     const auto& s = svd_.singularValues();
@@ -55,6 +50,35 @@ void WeightedNullSpace::compute(const Eigen::Ref<const MatrixX>& J, const Vector
     for (Eigen::Index i = 0; i < s.size(); ++i)
       if (s(i) * s(i) > tol_ * smax * smax && smax > 0) ++rank_;
   }
+}
+
+void WeightedNullSpace::factorGram() {
+  ldlt_.compute(G_);
+  const auto& D = ldlt_.vectorD();
+  const double dmax = D.size() > 0 ? D.cwiseAbs().maxCoeff() : 0.0;
+  const double cut = tol_ * dmax;
+  rank_ = 0;
+  for (Eigen::Index i = 0; i < D.size(); ++i)
+    if (D(i) > cut && dmax > 0) ++rank_;
+}
+
+void WeightedNullSpace::computeWithGram(const Eigen::Ref<const MatrixX>& J, const VectorX& w_inv,
+                                        const Eigen::Ref<const MatrixX>& G) {
+  if (method_ != ProjectorMethod::kLdlt) {
+    compute(J, w_inv);
+    return;
+  }
+  if (J.rows() != rows_ || J.cols() != n_ || w_inv.size() != n_ || G.rows() != rows_ || G.cols() != rows_)
+    throw std::invalid_argument("WeightedNullSpace::computeWithGram: J is " + std::to_string(J.rows()) + "x" +
+                                std::to_string(J.cols()) + " and G " + std::to_string(G.rows()) + "x" +
+                                std::to_string(G.cols()) + ", expected " + std::to_string(rows_) + "x" +
+                                std::to_string(n_) + " and " + std::to_string(rows_) + "x" + std::to_string(rows_));
+  rank_ = 0;
+  if (rows_ == 0) return;
+  J_ = J;
+  w_inv_ = w_inv;
+  G_.triangularView<Eigen::Lower>() = G;
+  factorGram();
 }
 
 void WeightedNullSpace::projectTorque(const VectorX& g, VectorX& out) {

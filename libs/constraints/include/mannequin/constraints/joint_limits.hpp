@@ -94,7 +94,7 @@ class JointLimitRows final : public RowProducer {
     double lower = 0, upper = 0;
   };
   struct BallRow {  // a swing/twist row of the step, for refine()
-    int row = -1, joint = -1;
+    int row = -1, joint = -1, ball = -1;  // ball: index in balls_
     int kind = 0;  // 0 swing, 1 twist lower, 2 twist upper
     bool singular = false;
     double d = 0, scale = 0;  // d at q_k, κ at q_k
@@ -117,6 +117,22 @@ class JointLimitRows final : public RowProducer {
   std::vector<BallRow> ball_rows_;
   std::vector<char> box_rows_;       // 2 per box: its lower/upper row is in the step
   std::vector<char> ball_has_rows_;  // per ball: its rows are in the step
+  // per ball, from addRows() for refine(): R_k = exp(q_ball) and the distances there (valid when
+  // ball_eval_ is set: a ball skipped by the cheap bound has neither)
+  std::vector<Eigen::Matrix3d> ball_R_;
+  std::vector<BallLimitDistances> ball_d_;
+  std::vector<char> ball_eval_;
+  // per ball, fixed: the bound behind the cheap skips (see farFromLimits())
+  struct BallBound {
+    double rho_min = 0;    // rad: smallest ellipse radius over the swing directions (lower bound)
+    double slope_min = 0;  // d_s ≥ slope_min (ρ_min − θ_s) for θ_s ≤ ρ_min
+    double grad_max = 0;   // |κ dh/ds| ≤ grad_max where θ_s ≤ ρ_min
+    double twist_min = 0;  // rad: min(−twist_lower, twist_upper)
+  };
+  std::vector<BallBound> ball_bound_;
+  /// True when every rotation of angle ≤ theta is inside ball bi's cone and twist range with a
+  /// linearised distance of at least `margin` after a step of angular speed `speed` (rad/s) over dt.
+  bool farFromLimits(std::size_t bi, double theta, double speed, double dt, double margin) const;
   double worst_excess_ = 0.0;
 };
 

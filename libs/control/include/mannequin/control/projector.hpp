@@ -36,6 +36,10 @@ class WeightedNullSpace {
 
   /// Factorises for J (rows × n) and the diagonal of W⁻¹ (n, all > 0).
   void compute(const Eigen::Ref<const MatrixX>& J, const VectorX& w_inv);
+  /// As compute(), with G = J W⁻¹ Jᵀ formed by the caller (rows × rows, lower triangle read; e.g. a
+  /// leading block of the Gram of a larger Jacobian, built from its sparsity). The SVD method
+  /// ignores G and computes as compute().
+  void computeWithGram(const Eigen::Ref<const MatrixX>& J, const VectorX& w_inv, const Eigen::Ref<const MatrixX>& G);
   /// out = Πᵀ g, the torque g with its part acting on the task removed. out may alias g.
   void projectTorque(const VectorX& g, VectorX& out);
   /// Π as a dense n × n matrix (allocates; for tests and tools).
@@ -56,6 +60,7 @@ class WeightedNullSpace {
   MatrixX G_;        // (rows × rows) J W⁻¹ Jᵀ, lower triangle
   Eigen::LDLT<MatrixX> ldlt_;
   Eigen::JacobiSVD<MatrixX> svd_;
+  void factorGram();  // ldlt_ of G_ and the rank
   VectorX y_, z_;    // (rows)
   VectorX t_;        // (n)
   VectorX r_;        // (rank ≤ rows) for the SVD path
