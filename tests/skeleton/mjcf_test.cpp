@@ -204,15 +204,15 @@ TEST(Mjcf, RandomTreeNestsBodiesAsTheJointTree) {
   ASSERT_EQ(error, "");
   // each joint's body is a direct child of its parent joint's body
   std::map<std::string, std::string> parent_of;
-  std::vector<std::pair<const Element*, std::string>> todo{{&doc.children.at(0), ""}};
-  while (!todo.empty()) {
-    auto [e, parent] = todo.back();
-    todo.pop_back();
+  std::vector<std::pair<const Element*, std::string>> pending{{&doc.children.at(0), ""}};
+  while (!pending.empty()) {
+    auto [e, parent] = pending.back();
+    pending.pop_back();
     for (const Element& ch : e->children) {
-      if (ch.tag == "worldbody") todo.push_back({&ch, ""});
+      if (ch.tag == "worldbody") pending.push_back({&ch, ""});
       if (ch.tag == "body") {
         parent_of[ch.attrs.at("name")] = parent;
-        todo.push_back({&ch, ch.attrs.at("name")});
+        pending.push_back({&ch, ch.attrs.at("name")});
       }
     }
   }

@@ -15,6 +15,7 @@
 
 #include "mannequin/collision/geometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
+#include "mannequin/math/frame.hpp"
 #include "narrowphase.hpp"
 
 namespace mannequin::collision {
@@ -66,18 +67,7 @@ struct MannequinEntry {
 
 constexpr double kBig = 1e6;
 
-Matrix3 frameAlong(const Vector3& dir) {
-  // z along dir; x from the joint's z (or x) projected; deterministic
-  const Vector3 z = dir.normalized();
-  Vector3 ref = Vector3::UnitZ();
-  if (std::abs(z.dot(ref)) > 0.9) ref = Vector3::UnitX();
-  const Vector3 x = (ref - ref.dot(z) * z).normalized();
-  Matrix3 R;
-  R.col(0) = x;
-  R.col(1) = z.cross(x);
-  R.col(2) = z;
-  return R;
-}
+using math::frameAlong;
 
 }  // namespace
 

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "mannequin/math/so3.hpp"
+#include "mannequin/math/frame.hpp"
 
 namespace mannequin::skeleton {
 
@@ -33,18 +34,7 @@ std::string quat(const Matrix3& R) {
   return num(qt.w()) + " " + num(qt.x()) + " " + num(qt.y()) + " " + num(qt.z());
 }
 
-/// z along dir, x from the z axis (or x) projected: collision::CollisionWorld's frame of a capsule.
-Matrix3 frameAlong(const Vector3& dir) {
-  const Vector3 z = dir.normalized();
-  Vector3 ref = Vector3::UnitZ();
-  if (std::abs(z.dot(ref)) > 0.9) ref = Vector3::UnitX();
-  const Vector3 x = (ref - ref.dot(z) * z).normalized();
-  Matrix3 R;
-  R.col(0) = x;
-  R.col(1) = z.cross(x);
-  R.col(2) = z;
-  return R;
-}
+using math::frameAlong;  // collision::CollisionWorld's and the MJCF export's frame of a capsule
 
 std::string xmlName(const std::string& s) {
   std::string out;
@@ -64,19 +54,19 @@ std::string xmlName(const std::string& s) {
 /// MuJoCo numbers its bodies, joints and qpos in this order.
 std::vector<int> documentOrder(const Model& model) {
   std::vector<std::vector<int>> children(model.joints.size());
-  std::vector<int> todo;
+  std::vector<int> pending;
   for (std::size_t j = model.joints.size(); j-- > 0;) {
     const int p = model.joints[j].parent;
-    if (p < 0) todo.push_back(static_cast<int>(j));
+    if (p < 0) pending.push_back(static_cast<int>(j));
     else children[static_cast<std::size_t>(p)].push_back(static_cast<int>(j));
   }
   std::vector<int> order;
-  while (!todo.empty()) {
-    const int j = todo.back();
-    todo.pop_back();
+  while (!pending.empty()) {
+    const int j = pending.back();
+    pending.pop_back();
     order.push_back(j);
     const std::vector<int>& c = children[static_cast<std::size_t>(j)];  // in decreasing index order
-    todo.insert(todo.end(), c.begin(), c.end());
+    pending.insert(pending.end(), c.begin(), c.end());
   }
   return order;
 }
