@@ -458,3 +458,47 @@ TEST(ConstraintSolver, RefinementKeepsACurvedRowAtTheNextStepNotOnlyToFirstOrder
   EXPECT_LE(rounds, 6);
   std::printf("disk: worst excess %.3g m first order, %.3g m refined (at most %d rounds)\n", linear, refined, rounds);
 }
+
+// Warm start (SolverOptions::warm_start): from the second step on, the previous step's basis answers
+// the LCP of a box at rest or sliding on a slope with 0 pivots, and the motion is the cold solver's
+TEST(ConstraintSolver, WarmStartAnswersSteadyStepsWithTheColdMotion) {
+  const double m = 3.0, tau = 0.05, dt = 0.005, a = 20.0 * std::numbers::pi / 180.0;
+  const Eigen::Vector3d n(-std::sin(a), 0.0, std::cos(a));
+  for (const double mu : {0.8, 0.2}) {
+    SCOPED_TRACE(testing::Message() << "mu " << mu);
+    PointSystem warm_p(3, 1, m, tau), cold_p(3, 1, m, tau);
+    PlaneProducer warm_plane(warm_p, 0, n, mu, 4), cold_plane(cold_p, 0, n, mu, 4);
+    SolverOptions o;
+    o.max_rows = 4;
+    o.max_friction_rows = 2;
+    SolverOptions oc = o;
+    oc.warm_start = false;
+    ConstraintSolver warm({&warm_p}, o), cold({&cold_p}, oc);
+    warm.addProducer(&warm_plane);
+    cold.addProducer(&cold_plane);
+    int answered = 0;
+    for (int k = 0; k < 40; ++k) {
+      warm_p.freeMotion(gravity(warm_p));
+      cold_p.freeMotion(gravity(cold_p));
+      const SolveReport& rw = warm.solve(dt);
+      const SolveReport& rc = cold.solve(dt);
+      ASSERT_EQ(rw.solver, SolverUsed::kLemke);
+      ASSERT_EQ(rc.solver, SolverUsed::kLemke);
+      EXPECT_EQ(rc.warm, 0);
+      EXPECT_EQ(rw.lcp_solves, 1);
+      if (k == 0) {
+        EXPECT_EQ(rw.warm, 0);  // nothing to start from
+      }
+      if (rw.warm == 1) {
+        EXPECT_EQ(rw.pivots, 0);
+        ++answered;
+      }
+      EXPECT_LE((warm_p.qdot - cold_p.qdot).lpNorm<Eigen::Infinity>(), 1e-12) << "step " << k;
+      EXPECT_NEAR(warm_plane.lambda, cold_plane.lambda, 1e-9);
+      EXPECT_NEAR(warm_plane.friction, cold_plane.friction, 1e-9);
+      warm_p.integrate(dt);
+      cold_p.integrate(dt);
+    }
+    EXPECT_EQ(answered, 39);  // every step after the first
+  }
+}

@@ -4,6 +4,8 @@
 #include <gtest/gtest.h>
 
 #include <cstddef>
+#include <cstdint>
+#include <vector>
 
 #include "mannequin/lcp/lemke.hpp"
 #include "mannequin/lcp/pgs.hpp"
@@ -160,5 +162,45 @@ TEST(Allocation, CapacityPathVaryingSizeAllocatesNothing) {
     if (ps == LcpStatus::Solved) {
       EXPECT_LT((wl - (M * zp + q)).lpNorm<Eigen::Infinity>(), 1e-6) << n;
     }
+  }
+}
+
+// the warm start's path (the guess tried, accepted or not, then Lemke) allocates nothing once the
+// workspace has held the largest guess
+TEST(Allocation, LemkeWarmStartAllocatesNothing) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "malloc is owned by AddressSanitizer";
+#endif
+  const Index n = 40;
+  const auto c = gen::makeContactLike(n, 3);
+  const Eigen::MatrixXd M = c.A * c.A.transpose();
+  class Dense final : public LcpMatrixOperator {
+   public:
+    explicit Dense(const Eigen::MatrixXd& m) : m_(m) {}
+    Index size() const override { return m_.rows(); }
+    void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const override { out = m_.col(j); }
+    void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override { out.noalias() = m_ * z; }
+    double maxAbs() const override { return m_.cwiseAbs().maxCoeff(); }
+
+   private:
+    const Eigen::MatrixXd& m_;
+  } op(M);
+  LemkeWorkspace ws;
+  ws.reserve(n);
+  LcpResult r;
+  r.reserve(n);
+  ASSERT_EQ(solveLemke(op, c.lcp.q, ws, LemkeOptions{}, r), LcpStatus::Solved);
+  std::vector<std::uint8_t> good(ws.basis(), ws.basis() + n), all(static_cast<std::size_t>(n), 1);
+  bool used = false;
+  solveLemkeWarm(op, c.lcp.q, all.data(), ws, LemkeOptions{}, r, &used);  // warm-up: the largest guess
+  for (const std::vector<std::uint8_t>* guess : {&good, &all, &good}) {
+    LcpStatus s = LcpStatus::Invalid;
+    const long allocations = countAllocations([&] {
+      const NoEigenMalloc no_eigen_malloc;
+      s = solveLemkeWarm(op, c.lcp.q, guess->data(), ws, LemkeOptions{}, r, &used);
+    });
+    EXPECT_EQ(s, LcpStatus::Solved);
+    EXPECT_EQ(used, guess == &good);
+    EXPECT_EQ(allocations, 0);
   }
 }

@@ -457,3 +457,134 @@ TEST(Lemke, ProductFormRestartsDenseWhenItsEtaFileIsFull) {
   }
   EXPECT_GE(restarted, 3);
 }
+
+namespace {
+// a dense M as an operator (the warm start's entry takes one)
+class DenseOperator final : public LcpMatrixOperator {
+ public:
+  explicit DenseOperator(const Eigen::MatrixXd& M) : M_(M) {}
+  Index size() const override { return M_.rows(); }
+  void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const override { out = M_.col(j); }
+  void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override { out.noalias() = M_ * z; }
+  double maxAbs() const override { return M_.cwiseAbs().maxCoeff(); }
+
+ private:
+  const Eigen::MatrixXd& M_;
+};
+
+std::vector<std::uint8_t> basisOf(const LemkeWorkspace& ws, Index n) { return {ws.basis(), ws.basis() + n}; }
+}  // namespace
+
+// Warm start (solveLemkeWarm): given the basis of a problem's own answer, the answer comes back with
+// 0 pivots and the same z; the basis of a nearby problem (q moved a little, as between two steps)
+// is accepted when it is still the answer's, and whatever the guess, the answer passes the same
+// check as a cold solve
+TEST(LemkeWarm, OwnBasisAnswersAtOncePerturbedQStillSolves) {
+  int accepted_nearby = 0, cases = 0;
+  for (std::uint32_t seed = 1; seed <= 6; ++seed) {
+    for (const Index n : {8, 40, 120}) {
+      const auto c = gen::makeContactLike(n, seed);
+      const Eigen::MatrixXd M = c.A * c.A.transpose();
+      const DenseOperator op(M);
+      LemkeWorkspace ws;
+      LcpResult cold, warm;
+      cold.reserve(n);
+      warm.reserve(n);
+      ASSERT_EQ(solveLemke(op, c.lcp.q, ws, LemkeOptions{}, cold), LcpStatus::Solved) << cold.message;
+      const std::vector<std::uint8_t> basis = basisOf(ws, n);
+      bool used = false;
+      ASSERT_EQ(solveLemkeWarm(op, c.lcp.q, basis.data(), ws, LemkeOptions{}, warm, &used), LcpStatus::Solved);
+      EXPECT_TRUE(used) << "n " << n << " seed " << seed;
+      EXPECT_EQ(warm.pivots, 0);
+      const double scale = std::max(1.0, cold.z.head(n).lpNorm<Eigen::Infinity>());
+      EXPECT_LE((warm.z.head(n) - cold.z.head(n)).lpNorm<Eigen::Infinity>(), 1e-8 * scale);
+      // the free velocity moved a little (q = A v_free + d, d ≥ 0, as the next step of a simulation):
+      // the same basis usually still answers; either way the answer is one
+      std::mt19937 rng(seed);
+      std::uniform_real_distribution<double> u(-1.0, 1.0);
+      Eigen::VectorXd dv(c.A.cols());
+      for (Index i = 0; i < dv.size(); ++i) dv[i] = 1e-4 * u(rng);
+      const Eigen::VectorXd q2 = c.lcp.q + c.A * dv;
+      ASSERT_EQ(solveLemkeWarm(op, q2, basis.data(), ws, LemkeOptions{}, warm, &used), LcpStatus::Solved);
+      EXPECT_TRUE(isComplementary(warm.residuals, 1e-9));
+      accepted_nearby += used ? 1 : 0;
+      ++cases;
+    }
+  }
+  // a small move of q keeps most bases (not all: an entry at 0 may change sides)
+  EXPECT_GE(accepted_nearby, cases / 2);
+}
+
+// a wrong guess (every z basic, no z basic, the complement of the answer's basis) and a singular
+// one (two identical rows both basic) fall back to Lemke: Solved, the cold answer's quality
+TEST(LemkeWarm, WrongOrSingularGuessFallsBackToLemke) {
+  const Index n = 30;
+  auto c = gen::makeContactLike(n, 11);
+  c.A.row(5) = c.A.row(4);  // rows 4 and 5 identical: M singular on {4, 5}
+  const Eigen::MatrixXd M = c.A * c.A.transpose();
+  Eigen::VectorXd q = c.lcp.q;
+  q[4] = q[5] = -1.0;
+  const DenseOperator op(M);
+  LemkeWorkspace ws;
+  LcpResult cold, warm;
+  cold.reserve(n);
+  warm.reserve(n);
+  ASSERT_EQ(solveLemke(op, q, ws, LemkeOptions{}, cold), LcpStatus::Solved) << cold.message;
+  std::vector<std::uint8_t> complement = basisOf(ws, n);
+  for (auto& b : complement) b = b != 0 ? 0 : 1;
+  std::vector<std::uint8_t> singular(static_cast<std::size_t>(n), 0);
+  singular[4] = singular[5] = 1;
+  std::vector<std::uint8_t> all(static_cast<std::size_t>(n), 1);
+  std::vector<std::uint8_t> none(static_cast<std::size_t>(n), 0);
+  for (const std::vector<std::uint8_t>* guess : {&complement, &singular, &all, &none}) {
+    bool used = true;
+    ASSERT_EQ(solveLemkeWarm(op, q, guess->data(), ws, LemkeOptions{}, warm, &used), LcpStatus::Solved) << warm.message;
+    EXPECT_FALSE(used);
+    EXPECT_GT(warm.pivots, 0);
+    EXPECT_TRUE(isComplementary(warm.residuals, 1e-9));
+    // M is PSD: every answer has the same w
+    EXPECT_LE((warm.w.head(n) - cold.w.head(n)).lpNorm<Eigen::Infinity>(), 1e-8 * (1.0 + q.lpNorm<Eigen::Infinity>()));
+  }
+  // no guess at all: Lemke
+  bool used = true;
+  ASSERT_EQ(solveLemkeWarm(op, q, nullptr, ws, LemkeOptions{}, warm, &used), LcpStatus::Solved);
+  EXPECT_FALSE(used);
+  EXPECT_EQ(warm.pivots, cold.pivots);
+}
+
+// a nonsymmetric LCP with friction's structure (the Stewart–Trinkle cone rows of the constraint
+// solver: w_γ = μλ − Σβ, w_edge = … + γ): its own basis, degenerate entries included, answers at once
+TEST(LemkeWarm, FrictionStructureDegenerateBasis) {
+  // one contact, 4 edges, a unit Delassus block on (λ, β1..β4) from a normal n and tangents ±t1, ±t2
+  // of a point of mass 1 pushed into the plane and sideways, μ = 0.5: sticking
+  const Index n = 6;  // λ, β1..β4, γ
+  Eigen::MatrixXd R(5, 3);
+  R << 0, 0, 1,  1, 0, 0,  0, 1, 0,  -1, 0, 0,  0, -1, 0;
+  Eigen::MatrixXd M = Eigen::MatrixXd::Zero(n, n);
+  M.topLeftCorner(5, 5) = R * R.transpose();
+  M(5, 0) = 0.5;
+  for (Index k = 1; k <= 4; ++k) {
+    M(5, k) = -1.0;
+    M(k, 5) = 1.0;
+  }
+  Eigen::VectorXd q(n);
+  const Eigen::Vector3d v_free(0.1, 0.05, -1.0);  // into the plane, a little sideways
+  q.head(5) = R * v_free;
+  q[5] = 0.0;
+  const DenseOperator op(M);
+  LemkeWorkspace ws;
+  LcpResult cold, warm;
+  cold.reserve(n);
+  warm.reserve(n);
+  ASSERT_EQ(solveLemke(op, q, ws, LemkeOptions{}, cold), LcpStatus::Solved) << cold.message;
+  // sticking: the point stops (R q̇ = 0 on the normal and every edge), friction inside the cone
+  const Eigen::Vector3d f = R.transpose() * cold.z.head(5);
+  EXPECT_NEAR(f.z(), 1.0, 1e-12);
+  EXPECT_NEAR(f.x(), -0.1, 1e-12);
+  EXPECT_NEAR(f.y(), -0.05, 1e-12);
+  const std::vector<std::uint8_t> basis = basisOf(ws, n);
+  bool used = false;
+  ASSERT_EQ(solveLemkeWarm(op, q, basis.data(), ws, LemkeOptions{}, warm, &used), LcpStatus::Solved);
+  EXPECT_TRUE(used);
+  EXPECT_LE((R.transpose() * (warm.z.head(5) - cold.z.head(5))).norm(), 1e-12);
+}

@@ -355,7 +355,13 @@ bool JointLimitRows::refine(int id, double dt, RowSet& rows, const std::vector<E
     const double c = d_next - linear;
     if (!std::isfinite(c)) continue;
     RowInfo& in = rows.info(b.row);
-    if ((in.lambda > 0.0 || d_next < 0.0) && std::abs(c - in.correction) > kTolerance) again = true;
+    // the row is at its bound in this answer when the distance it predicts for the end of the step (the
+    // LCP's w_r δt) is 0 — whatever λ the answer gives it: an LCP with redundant rows has several
+    // answers with the same velocities and different λ (the warm start may pick another), and the
+    // decision to solve again must not depend on which
+    const double v_rec = std::isfinite(in.recovery_speed) ? std::max(0.0, in.recovery_speed) : 0.0;
+    const double w_dt = std::max(b.d, -v_rec * dt) + in.correction + (linear - b.d);
+    if ((w_dt <= kTolerance || d_next < 0.0) && std::abs(c - in.correction) > kTolerance) again = true;
     in.correction = c;
   }
   // 2. late rows: limits without a row that this velocity carries past (the forces at the other rows

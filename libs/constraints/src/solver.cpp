@@ -58,6 +58,8 @@ class DelassusOperator final : public lcp::LcpMatrixOperator {
     int nfric = 0;
     const std::vector<double>* mu = nullptr;  // per friction row
     double max_abs = 0.0;
+    std::vector<Eigen::MatrixXd>* gathered = nullptr;  // per system: nv_s × cap_f (principal())
+    std::vector<int>* where = nullptr;                 // cap_n entries, all −1 between calls
   };
   explicit DelassusOperator(const Data& d) : d_(d) {}
   Eigen::Index size() const override { return d_.n; }
@@ -93,6 +95,40 @@ class DelassusOperator final : public lcp::LcpMatrixOperator {
     }
   }
   double maxAbs() const override { return d_.max_abs; }
+  // the principal block on idx (ascending): Σ_s X_s,Bᵀ X_s,B over the force rows of idx (one product
+  // of gathered columns instead of k column reads) plus the friction structure's entries
+  void principal(const int* idx, Eigen::Index k, Eigen::Ref<Eigen::MatrixXd> out,
+                 Eigen::Ref<Eigen::VectorXd> /*scratch*/) const override {
+    out.setZero();
+    Eigen::Index kF = 0;
+    while (kF < k && idx[kF] < d_.nF) ++kF;
+    if (kF > 0) {
+      for (int s = 0; s < d_.ns; ++s) {
+        if (!((d_.touched >> s) & 1u)) continue;
+        const auto us = static_cast<std::size_t>(s);
+        const Eigen::MatrixXd& X = (*d_.X)[us];
+        auto G = (*d_.gathered)[us].leftCols(kF);
+        for (Eigen::Index c = 0; c < kF; ++c) G.col(c) = X.col(idx[c]);
+        out.topLeftCorner(kF, kF).noalias() += G.transpose() * G;
+      }
+    }
+    std::vector<int>& at = *d_.where;
+    for (Eigen::Index c = 0; c < k; ++c) at[static_cast<std::size_t>(idx[c])] = static_cast<int>(c);
+    for (int f = 0; f < d_.nfric; ++f) {
+      const int* e = &(*d_.fric)[static_cast<std::size_t>(4 * f)];
+      const int g = at[static_cast<std::size_t>(e[3])];
+      if (g < 0) continue;
+      const int p = at[static_cast<std::size_t>(e[0])];
+      if (p >= 0) out(g, p) += (*d_.mu)[static_cast<std::size_t>(f)];
+      for (int j = e[1]; j < e[1] + e[2]; ++j) {
+        const int b = at[static_cast<std::size_t>(j)];
+        if (b < 0) continue;
+        out(g, b) -= 1.0;
+        out(b, g) += 1.0;
+      }
+    }
+    for (Eigen::Index c = 0; c < k; ++c) at[static_cast<std::size_t>(idx[c])] = -1;
+  }
 
  private:
   Data d_;
@@ -120,6 +156,20 @@ struct ConstraintSolver::Impl {
   Eigen::VectorXd z_prev;                // cap_n: the answer before a re-solve (refinement)
   Eigen::MatrixXd A;                     // cap_nn × Σ nv_s: frictionless A = [R_s L_s⁻ᵀ]_s
   lcp::LcpResult result;                 // cap_n
+  // warm start: the basis guessed from the previous step's answer (rows matched by RowKey)
+  struct RowKey {
+    int producer = -1, tag = -1, system_a = -1, system_b = -1, edges = 0;
+    RowSource source = RowSource::kOther;
+    RowKind kind = RowKind::kUnilateral;
+    bool operator==(const RowKey&) const = default;
+  };
+  std::vector<Eigen::MatrixXd> gathered;     // per system: nv_s × cap_f (DelassusOperator::principal)
+  std::vector<int> where;                    // cap_n, −1 (DelassusOperator::principal)
+  std::vector<std::uint8_t> basic;           // cap_n: the guess for this solve
+  std::vector<RowKey> prev_key;              // per row of the previous step
+  std::vector<int> prev_pos, prev_neg, prev_edge, prev_gam;  // its LCP layout
+  std::vector<std::uint8_t> prev_basic;      // cap_n: z > 0 in its answer
+  int prev_nr = 0;
   lcp::LemkeWorkspace lemke;
   lcp::StructuredWorkspace structured;
   lcp::PgsWorkspace pgs;
@@ -171,6 +221,7 @@ ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, cons
     im.X.emplace_back(Eigen::MatrixXd::Zero(nv, im.cap_f));
     im.gamma.emplace_back(Eigen::VectorXd::Zero(nv));
     im.velocity.emplace_back(Eigen::VectorXd::Zero(nv));
+    im.gathered.emplace_back(Eigen::MatrixXd::Zero(nv, im.cap_f));
     im.m_total += nv;
   }
   const auto mr = static_cast<std::size_t>(options.max_rows);
@@ -180,6 +231,14 @@ ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, cons
   im.gam.assign(mr, -1);
   im.fric.assign(4 * mr, 0);
   im.mu.assign(mr, 0.0);
+  im.where.assign(static_cast<std::size_t>(im.cap_n), -1);
+  im.basic.assign(static_cast<std::size_t>(im.cap_n), 0);
+  im.prev_basic.assign(static_cast<std::size_t>(im.cap_n), 0);
+  im.prev_key.assign(mr, Impl::RowKey{});
+  im.prev_pos.assign(mr, -1);
+  im.prev_neg.assign(mr, -1);
+  im.prev_edge.assign(mr, -1);
+  im.prev_gam.assign(mr, -1);
   im.diag = Eigen::VectorXd::Zero(im.cap_f);
   im.q = Eigen::VectorXd::Zero(im.cap_n);
   im.q_base = Eigen::VectorXd::Zero(im.cap_n);
@@ -226,7 +285,48 @@ const SolveReport& ConstraintSolver::solve(double dt) {
   int nr = 0, nN = 0, nF = 0, nz = 0;  // nz: force rows of the answer
   std::uint64_t touched = 0;
   int rounds_left = options_.refine_rounds;
+  int n_lcp = 0;  // size of the LCP of the answer
   auto t2 = t1;
+  const auto keyOf = [&](int r) {
+    const RowInfo& in = rows_.info(r);
+    return Impl::RowKey{in.producer, in.tag, in.system_a, in.system_b,
+                        rows_.frictionSlot(r) >= 0 ? in.friction_edges : 0, in.source, in.kind};
+  };
+  // warm start: each row matched to the previous step's row with the same key (producers emit their
+  // rows in a stable order, so a cursor with a short look-ahead finds them), its variables flagged
+  // basic where they were > 0; nullptr when nothing matched (a cold start)
+  const auto guessFromPrevious = [&](int n) -> const std::uint8_t* {
+    if (!options_.warm_start || im.prev_nr == 0) return nullptr;
+    constexpr int kLookAhead = 8;
+    std::fill_n(im.basic.begin(), n, std::uint8_t{0});
+    bool any = false;
+    for (int r = 0, c = 0; r < nr; ++r) {
+      const Impl::RowKey key = keyOf(r);
+      int found = -1;
+      for (int t = c; t < std::min(im.prev_nr, c + kLookAhead); ++t) {
+        if (im.prev_key[static_cast<std::size_t>(t)] == key) {
+          found = t;
+          break;
+        }
+      }
+      if (found < 0) continue;
+      c = found + 1;
+      const auto ur = static_cast<std::size_t>(r), uf = static_cast<std::size_t>(found);
+      const auto copy = [&](int to, int from, int count) {
+        if (to < 0 || from < 0) return;
+        for (int j = 0; j < count; ++j) {
+          const std::uint8_t b = im.prev_basic[static_cast<std::size_t>(from + j)];
+          im.basic[static_cast<std::size_t>(to + j)] = b;
+          any = any || b != 0;
+        }
+      };
+      copy(im.pos[ur], im.prev_pos[uf], 1);
+      copy(im.neg[ur], im.prev_neg[uf], 1);
+      copy(im.edge[ur], im.prev_edge[uf], key.edges);
+      copy(im.gam[ur], im.prev_gam[uf], 1);
+    }
+    return any ? im.basic.data() : nullptr;
+  };
   // steps 2–3 (and 5) — again from the assembly when a refine() added rows
   for (bool assemble = true; assemble;) {
     assemble = false;
@@ -350,6 +450,8 @@ const SolveReport& ConstraintSolver::solve(double dt) {
     od.nfric = nfric;
     od.mu = &im.mu;
     od.max_abs = max_abs;
+    od.gathered = &im.gathered;
+    od.where = &im.where;
     const DelassusOperator M(od);
     t2 = Clock::now();
     rep.assemble_s = seconds(t1, t2);
@@ -357,7 +459,12 @@ const SolveReport& ConstraintSolver::solve(double dt) {
 
     // 3. Lemke, then the frictionless problem by the structured solver, then PGS
     nz = 0;
-    const lcp::LcpStatus ls = lcp::solveLemke(M, q, im.lemke, options_.lemke, res);
+    n_lcp = n;
+    bool warm = false;
+    const lcp::LcpStatus ls =
+        lcp::solveLemkeWarm(M, q, guessFromPrevious(n), im.lemke, options_.lemke, res, &warm);
+    rep.lcp_solves += 1;
+    rep.warm += warm ? 1 : 0;
     rep.lemke_status = ls;
     rep.pivots = res.pivots;
     if (ls == lcp::LcpStatus::Solved && res.z.head(n).allFinite()) {
@@ -394,7 +501,12 @@ const SolveReport& ConstraintSolver::solve(double dt) {
         im.z_prev.head(n) = res.z.head(n);
         q = im.q_base.head(n);
         addDistances();
-        const lcp::LcpStatus rs = lcp::solveLemke(M, q, im.lemke, options_.lemke, res);
+        // the current answer's basis is the guess (only q moved, by O(δt²))
+        std::copy_n(im.lemke.basis(), n, im.basic.begin());
+        const lcp::LcpStatus rs = lcp::solveLemkeWarm(M, q, options_.warm_start ? im.basic.data() : nullptr, im.lemke,
+                                                      options_.lemke, res, &warm);
+        rep.lcp_solves += 1;
+        rep.warm += warm ? 1 : 0;
         ++rep.refine_rounds;
         rep.pivots = res.pivots;
         if (rs != lcp::LcpStatus::Solved || !res.z.head(n).allFinite()) {
@@ -466,6 +578,20 @@ const SolveReport& ConstraintSolver::solve(double dt) {
       in.friction = std::hypot(fx, fy);
     }
   }
+  // this answer's basis, the next step's guess
+  const int n_kept = rep.solver == SolverUsed::kLemke ? n_lcp : 0;  // a fallback's answer: no guess
+  im.prev_nr = nr;
+  for (int r = 0; r < nr; ++r) {
+    const auto ur = static_cast<std::size_t>(r);
+    im.prev_key[ur] = keyOf(r);
+    im.prev_pos[ur] = im.pos[ur];
+    im.prev_neg[ur] = im.neg[ur];
+    im.prev_edge[ur] = im.edge[ur];
+    im.prev_gam[ur] = im.gam[ur];
+  }
+  // Lemke's final basis (degenerate zeros included: without them the guessed block may be singular)
+  const std::uint8_t* const basis = im.lemke.basis();
+  for (int i = 0; i < n_lcp; ++i) im.prev_basic[static_cast<std::size_t>(i)] = i < n_kept && basis[i] != 0 ? 1 : 0;
   rep.solve_s = seconds(t2, Clock::now());
   for (std::size_t p = 0; p < producers_.size(); ++p) producers_[p]->solved(static_cast<int>(p), rows_);
   return rep;

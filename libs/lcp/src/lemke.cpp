@@ -25,6 +25,9 @@ void LemkeWorkspace::reserve(Index capacity) {
   eta_row_.reserve(static_cast<std::size_t>(capacity + 1));
   tie_col_.reserve(static_cast<std::size_t>(capacity));
   retry_.reserve(capacity);
+  warm_idx_.reserve(static_cast<std::size_t>(capacity));
+  basis_.resize(static_cast<std::size_t>(capacity), 0);
+  warm_perm_.reserve(static_cast<std::size_t>(capacity));
 }
 
 void LemkeWorkspace::resize(Index n) {
@@ -345,6 +348,7 @@ LcpStatus solveViews(const LcpMatrixOperator& M, const VectorView& q, LemkeWorks
     res.status = LcpStatus::Solved;
     res.message = "q >= 0: z = 0";
     finish(M, q, res.z.head(n), res.w.head(n), res);
+    if (workspace.capacity() >= n) std::fill_n(workspace.basis_.begin(), n, std::uint8_t{0});
     return res.status;
   }
   workspace.resize(n);
@@ -384,6 +388,13 @@ LcpStatus solveViews(const LcpMatrixOperator& M, const VectorView& q, LemkeWorks
     }
   }
   res.pivots = total;
+  if (res.status == LcpStatus::Solved) {  // the final basis (the last attempt's: a solved one ends the retries)
+    std::fill_n(workspace.basis_.begin(), n, std::uint8_t{0});
+    for (Index i = 0; i < n; ++i) {
+      const int v = workspace.basic_[static_cast<std::size_t>(i)];
+      if (v >= n && v < 2 * n) workspace.basis_[static_cast<std::size_t>(v - n)] = 1;
+    }
+  }
   return res.status;
 }
 
@@ -434,6 +445,92 @@ LcpStatus solveLemke(const MatrixView& M, const VectorView& q, LemkeWorkspace& w
   }
   if (err != nullptr) return invalid(result, err);
   return solveViews(DenseMatrix(M), q, workspace, options, result);
+}
+
+namespace {
+
+// In place LU with partial pivoting of A (k×k): A = P⁻¹ L U, perm[i] = original row of row i.
+// False when a pivot is below tol (the guessed basis is singular or nearly so).
+bool luInPlace(Eigen::Ref<Eigen::MatrixXd> A, std::vector<int>& perm, double tol) {
+  const Index k = A.rows();
+  perm.resize(static_cast<std::size_t>(k));
+  for (Index i = 0; i < k; ++i) perm[static_cast<std::size_t>(i)] = static_cast<int>(i);
+  for (Index j = 0; j < k; ++j) {
+    Index p = j;
+    A.col(j).tail(k - j).cwiseAbs().maxCoeff(&p);
+    p += j;
+    if (!(std::abs(A(p, j)) > tol)) return false;
+    if (p != j) {
+      A.row(p).swap(A.row(j));
+      std::swap(perm[static_cast<std::size_t>(p)], perm[static_cast<std::size_t>(j)]);
+    }
+    const Index below = k - j - 1;
+    A.col(j).tail(below) /= A(j, j);
+    A.bottomRightCorner(below, below).noalias() -= A.col(j).tail(below) * A.row(j).tail(below);
+  }
+  return true;
+}
+
+// the guessed basis's answer into res (true when it passes the final check)
+bool tryWarm(const LcpMatrixOperator& M, const VectorView& q, const std::uint8_t* basic, LemkeWorkspace& ws,
+             const LemkeOptions& options, LcpResult& res) {
+  const Index n = q.size();
+  auto& idx = ws.warm_idx_;
+  idx.clear();
+  for (Index i = 0; i < n; ++i) {
+    if (basic[i] != 0) idx.push_back(static_cast<int>(i));
+  }
+  const auto k = static_cast<Index>(idx.size());
+  if (k == 0) return false;
+  // the principal block and its LU in the tableau's buffer (free until Lemke's setup)
+  auto A = ws.tableau_.topLeftCorner(k, k);
+  auto scratch = ws.col_.head(n);
+  M.principal(idx.data(), k, A, scratch);
+  const double scale = std::max(M.maxAbs(), 1.0);
+  if (!luInPlace(A, ws.warm_perm_, 1e-10 * scale)) return false;
+  // z_B = −A⁻¹ q_B: forward (unit L) then back substitution, in ws.delta_
+  auto x = ws.delta_.head(k);
+  for (Index i = 0; i < k; ++i) x[i] = -q[idx[static_cast<std::size_t>(ws.warm_perm_[static_cast<std::size_t>(i)])]];
+  A.triangularView<Eigen::UnitLower>().solveInPlace(x);
+  A.triangularView<Eigen::Upper>().solveInPlace(x);
+  auto z = res.z.head(n);
+  z.setZero();
+  const double neg_tol = options.check_tolerance * (1.0 + q.lpNorm<Eigen::Infinity>());
+  for (Index i = 0; i < k; ++i) {
+    if (!std::isfinite(x[i]) || x[i] < -neg_tol) return false;
+    z[idx[static_cast<std::size_t>(i)]] = std::max(0.0, x[i]);
+  }
+  finish(M, q, z, res.w.head(n), res);
+  return isComplementary(res.residuals, options.check_tolerance);
+}
+
+const char* checkOperator(const LcpMatrixOperator& M, const VectorView& q, const LemkeOptions& options,
+                          const LcpResult& result) {
+  const char* err = M.size() != q.size() ? "q and M sizes differ" : nullptr;
+  if (err == nullptr && !q.allFinite()) err = "q has a NaN or Inf entry";
+  if (err == nullptr) err = checkOptions(options, q.size());
+  if (err == nullptr && (result.z.size() < q.size() || result.w.size() < q.size())) {
+    err = "result.z and result.w need at least n entries (LcpResult::reserve)";
+  }
+  return err;
+}
+
+}  // namespace
+
+LcpStatus solveLemkeWarm(const LcpMatrixOperator& M, const VectorView& q, const std::uint8_t* basic,
+                         LemkeWorkspace& workspace, const LemkeOptions& options, LcpResult& result, bool* warm) {
+  if (warm != nullptr) *warm = false;
+  if (const char* err = checkOperator(M, q, options, result)) return invalid(result, err);
+  workspace.resize(q.size());
+  if (basic != nullptr && q.size() > 0 && tryWarm(M, q, basic, workspace, options, result)) {
+    result.status = LcpStatus::Solved;
+    result.message = "solved (warm start: the guessed basis)";
+    result.pivots = 0;
+    std::copy_n(basic, q.size(), workspace.basis_.begin());
+    if (warm != nullptr) *warm = true;
+    return result.status;
+  }
+  return solveViews(M, q, workspace, options, result);
 }
 
 LcpStatus solveLemke(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace,

@@ -10,7 +10,8 @@
 ///      friction edge k of r: w_rk = A_rk z_R + R_rk q̇_free + γ_r                ⊥ β_rk ≥ 0
 ///      cone of r:           w_γr = μ_r λ_r − Σ_k β_rk                          ⊥ γ_r ≥ 0
 ///    (a bilateral row e is two rows ±e with distance ±d);
-/// 3. solved by Lemke (libs/lcp); if Lemke fails (ray, pivot limit, residual check), the
+/// 3. solved by Lemke (libs/lcp), warm-started from the previous answer's basis (SolverOptions::warm_start);
+///    if Lemke fails (ray, pivot limit, residual check), the
 ///    frictionless problem (normals and limits only, M = A Aᵀ PSD) is solved by the structured solver,
 ///    then by PGS; the report says which and is flagged. If every solver fails, no force is applied
 ///    (the step goes on unconstrained) — never a NaN;
@@ -67,6 +68,10 @@ struct SolverOptions {
   int max_friction_rows = 256;  ///< rows with a friction cone per step
   int max_edges = 4;            ///< largest friction_edges of a row
   int refine_rounds = 6;        ///< re-solves for the producers' corrections (step 5; 0: none)
+  /// Warm start (step 3): each LCP is first tried with the basis of the previous answer — the previous
+  /// step's, rows matched by (producer, tag, source, systems), or the previous refinement round's —
+  /// and Lemke runs only when that guess fails the final check (lcp::solveLemkeWarm).
+  bool warm_start = true;
   lcp::LemkeOptions lemke;
   lcp::StructuredOptions structured;
   lcp::PgsOptions pgs;
@@ -81,6 +86,8 @@ struct SolveReport {
   int active = 0;        ///< rows with λ > 0
   int pivots = 0;        ///< Lemke pivots (or the fallback's iterations; the last solve when refined)
   int refine_rounds = 0; ///< LCP re-solves for the producers' corrections (step 5)
+  int lcp_solves = 0;    ///< Lemke solves (the first and the refinement rounds')
+  int warm = 0;          ///< of those, answered by the warm-start guess (0 pivots)
   long dropped = 0;      ///< rows dropped for capacity since construction
   bool fallback = false; ///< Lemke failed and a fallback answered (or nothing did)
   double produce_s = 0, assemble_s = 0, solve_s = 0;  ///< wall time of each stage (s)

@@ -13,6 +13,7 @@
 /// Both use the workspace's tableau buffer (etas in its columns); nothing is allocated once the workspace has the right size (the overload writing into a
 /// caller's LcpResult allocates nothing at all once it has run on size n). For a copositive-plus
 /// M (e.g. symmetric positive semidefinite) ray termination proves the LCP has no solution.
+#include <cstdint>
 #include <vector>
 
 #include "mannequin/lcp/lcp.hpp"
@@ -61,6 +62,9 @@ class LemkeWorkspace {
   void resize(Index n);
   Index size() const { return n_; }
   Index capacity() const { return capacity_; }
+  /// The basis of the last Solved answer (n flags, 1: z_i basic — positive, or zero on a degenerate
+  /// vertex): the guess to give solveLemkeWarm for a nearby problem. All 0 after the trivial answer.
+  const std::uint8_t* basis() const { return basis_.data(); }
 
   // internal state, public so the solver is a free function (do not modify)
   Index n_ = -1;
@@ -82,6 +86,10 @@ class LemkeWorkspace {
   std::vector<int> eta_row_;   // product form: pivot row of each eta column
   std::vector<int> tie_col_;   // product form: tableau column holding row i's B⁻¹ row (−1: none)
   LcpResult retry_;            // result of a retry run (the in-place solve swaps it in)
+  // warm start (solveLemkeWarm; the guessed basis's principal block is factorised in the tableau's buffer)
+  std::vector<int> warm_idx_;  // k, indices of the guessed basic z's
+  std::vector<int> warm_perm_; // k, row permutation of the LU
+  std::vector<std::uint8_t> basis_;  // n, basis() (capacity-sized)
 };
 
 /// M known by its action, for problems whose M is a product (e.g. a Delassus matrix R b⁻¹ Rᵀ) that
@@ -96,6 +104,15 @@ class LcpMatrixOperator {
   virtual void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const = 0;
   /// max |M_ij| (the pivot tolerance's scale).
   virtual double maxAbs() const = 0;
+  /// out (k×k) = M restricted to rows and columns idx[0..k) (a principal block). The default reads
+  /// k columns; an operator with structure may do better. `scratch` has n entries.
+  virtual void principal(const int* idx, Index k, Eigen::Ref<Eigen::MatrixXd> out,
+                         Eigen::Ref<Eigen::VectorXd> scratch) const {
+    for (Index c = 0; c < k; ++c) {
+      column(idx[c], scratch);
+      for (Index r = 0; r < k; ++r) out(r, c) = scratch[idx[r]];
+    }
+  }
 };
 
 /// Solves 0 ≤ M z + q ⊥ z ≥ 0 (M n×n, q n) by Lemke's method.
@@ -121,5 +138,16 @@ LcpStatus solveLemke(const MatrixView& M, const VectorView& q, LemkeWorkspace& w
 /// column of M.
 LcpStatus solveLemke(const LcpMatrixOperator& M, const VectorView& q, LemkeWorkspace& workspace,
                      const LemkeOptions& options, LcpResult& result);
+
+/// Warm start from a guessed basis, e.g. the previous step's answer's (LemkeWorkspace::basis()):
+/// `basic` (n flags, nonzero: z_i basic). The guess is tried first — z_B = −M_BB⁻¹ q_B (LU with partial pivoting of the
+/// principal block), z_N = 0 — and is the answer (0 pivots, *warm = true) when it passes the same
+/// final check as a Lemke answer (z ≥ 0, w = Mz + q ≥ 0, wᵀz = 0 to options.check_tolerance).
+/// Otherwise (a wrong or singular guess, an empty one) Lemke runs from the start as solveLemke does.
+/// For a problem with several solutions (redundant contacts), the guess picks the one nearest the
+/// previous answer's structure. Same allocation contract as the capacity path.
+LcpStatus solveLemkeWarm(const LcpMatrixOperator& M, const VectorView& q, const std::uint8_t* basic,
+                         LemkeWorkspace& workspace, const LemkeOptions& options, LcpResult& result,
+                         bool* warm = nullptr);
 
 }  // namespace mannequin::lcp
