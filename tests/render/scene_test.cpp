@@ -115,6 +115,16 @@ TEST(RenderScene, AContactForceBecomesAnArrowWhoseLengthAndColourFollowTheNorm) 
   EXPECT_GT(c2[0], 0.9f);
   EXPECT_LT(c2[1], 0.15f);
 
+  // the force on the mannequin is drawn: a physics contact has the floor as body_a, its force (on a) points down
+  v1::WorldState fl;
+  v1::MannequinState* fm = fl.add_mannequins();
+  fm->set_name("op");
+  addContact(*fm, p, Vector3::UnitZ(), Vector3(0, 0, -100), "scene/floor", "op/foot_l");
+  const RenderScene sf = buildScene(fl, SceneAssets{}, style);
+  const Primitive* up = findTag(sf, "force:scene/floor:op/foot_l", Kind::kCone);
+  ASSERT_NE(up, nullptr);
+  EXPECT_GT(up->pose.R.col(2).z(), 1.0 - 1e-12);  // pointing up, out of the floor
+
   // length is clamped: a huge force is force_max_length long
   v1::WorldState big;
   addContact(*big.add_mannequins(), p, Vector3::UnitZ(), Vector3(1e6, 0, 0), "a", "b");

@@ -208,7 +208,11 @@ RenderScene buildScene(const v1::WorldState& state, const SceneAssets& assets, c
       s.colour = style.contact_colour;
       s.tag = "contact:" + c.body_a() + ":" + c.body_b();
       out.solids.push_back(std::move(s));
-      const Vector3 f = toVec(c.force());
+      // ContactPoint.force is the force on body_a; draw the one on the mannequin (physics contacts have the
+      // scene body as a: "scene/floor" → "operator/foot_l", the force on the floor points into it)
+      const std::string prefix = m.name() + "/";
+      const bool mannequin_is_b = c.body_a().rfind(prefix, 0) != 0 && c.body_b().rfind(prefix, 0) == 0;
+      const Vector3 f = mannequin_is_b ? Vector3(-toVec(c.force())) : toVec(c.force());
       const double fn = f.norm();
       if (fn > style.force_threshold) {
         const double len = std::clamp(style.force_scale * fn, style.force_min_length, style.force_max_length);

@@ -130,7 +130,8 @@ RenderScene buildStaticScene(const SceneAssets& assets, const Style& style = {})
 /// - static bodies of assets.scene (movable ones at the pose of the ObjectState of the same name if any);
 /// - per mannequin: a capsule per segment (pose = segments[i].pose · capsule), one colour per mannequin;
 /// - per contact: a small sphere at `point` (or the witness midpoint when `point` is unset), and when
-///   |force| > threshold an arrow from it along the force (length and colour from the norm);
+///   |force| > threshold an arrow from it along the force ON THE MANNEQUIN (ContactPoint.force is the force on
+///   body_a; it is negated when the mannequin's segment "<name>/<segment>" is body_b), length and colour from the norm;
 /// - per mannequin: the CoM (sphere) and the support polygon = the convex hull, projected on z = 0, of its
 ///   pressing contacts (|force| > threshold or normal_force > 0) with a vertical normal (|n_z| > 0.7) lower
 ///   than style.support_height (the feet on the floor); drawn as a line 4 mm above z = 0.
