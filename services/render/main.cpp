@@ -188,6 +188,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
     const auto start = std::chrono::steady_clock::now();
     const auto& stop = core::installStopSignals();
     const render::RenderScene still = render::buildStaticScene(assets, view.style);
+    long long swapped = 0;
     while (!glfwWindowShouldClose(win) && !stop.load()) {
       int w = 0, h = 0;
       glfwGetFramebufferSize(win, &w, &h);
@@ -207,6 +208,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
       }
       glfwSwapBuffers(win);
       glfwPollEvents();
+      if (o.frames > 0 && ++swapped >= o.frames) break;
     }
   }
   glfwDestroyWindow(win);
@@ -239,7 +241,7 @@ int main(int argc, char** argv) {
       });
   app.add_option("--out", o.out, "directory of the PNG frames (frame_NNNNNN.png, N = message index)");
   app.add_option("--every", o.every, "render every Nth message")->check(CLI::PositiveNumber)->capture_default_str();
-  app.add_option("--frames", o.frames, "write at most K frames (0: all)")->check(CLI::NonNegativeNumber);
+  app.add_option("--frames", o.frames, "write at most K frames (0: all); a window closes after K frames")->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical, off")->check(core::logLevelCheck());
   return core::runMain(app, argc, argv, [&] {
     core::setupLogging(log_level);

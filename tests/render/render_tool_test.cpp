@@ -138,6 +138,14 @@ TEST(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
   fs::remove(mcap);
 }
 
+TEST(RenderTool, OpensAWindowUnderXvfb) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); the window path is not tested";
+  const ToolRun r = run("--view configs/views/desktop.yaml --scene configs/scenes/table.yaml --frames 3", "xvfb-run -a");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("window 1280x720"), std::string::npos) << r.err;
+}
+
 TEST(RenderTool, BadSizeAndMissingOutAreUsageErrors) {
   const ToolRun size = run("--headless --size 12x --out " + temp("o").string());
   EXPECT_EQ(size.status, 2) << size.err;
