@@ -88,7 +88,7 @@ struct Style {
   double contact_radius = 0.015;    ///< m
   double com_radius = 0.035;        ///< m
   double support_height = 0.1;      ///< m: pressing contacts with a vertical normal below this span the support polygon
-  double plane_extent = 12.0;       ///< m: side of the square a plane is drawn as
+  double plane_extent = 40.0;       ///< m: side of the square a plane is drawn as
   double fallback_segment_radius = 0.05;  ///< m: a segment of a mannequin whose model is unknown
 };
 
