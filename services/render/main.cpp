@@ -2,7 +2,8 @@
 //   --headless: an off-screen EGL context, PNG frames into --out (deterministic: the same input gives the
 //               same files); --from F.mcap renders the sim.world messages of a recording frame by frame.
 //   otherwise:  a GLFW window (needs a display); --from plays the recording at its own pace, looping.
-// Not yet (issue 14, later steps): the live sim.world subscription, the swap barrier, the tracked head.
+//   --connect:  the live sim.world of publishers (newest state; headless: a frame per new state).
+// Not yet (issue 14, later steps): the service kit (heartbeats, launcher), the swap barrier, the tracked head.
 #include <GLFW/glfw3.h>
 
 #include <chrono>
@@ -21,6 +22,8 @@
 #include "mannequin/render/renderer.hpp"
 #include "mannequin/render/view.hpp"
 #include "mannequin/simservice/config.hpp"
+#include "mannequin/transport/subscriber.hpp"
+#include "mannequin/transport/topics.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/v1/world.pb.h"
 
@@ -34,6 +37,8 @@ constexpr const char* kWorldTopic = "sim.world";
 struct Options {
   std::string view = "configs/views/desktop.yaml";
   std::string sim, scene, from, out, size;
+  std::vector<std::string> connect;  // live sim.world publishers
+  double duration = 0;               // live: s of wall time (0: until SIGINT/SIGTERM or --frames)
   bool headless = false;
   int every = 1;
   long long frames = 0;  // 0: all
@@ -83,6 +88,34 @@ std::vector<v1::WorldState> readRecording(const std::string& path) {
   return out;
 }
 
+/// The newest sim.world of the publishers in `o.connect` (kLatest: a backlog is skipped; the publisher
+/// re-sends its last state to a late subscriber, so a node shows the current scene at once).
+class LiveWorld {
+ public:
+  explicit LiveWorld(const std::vector<std::string>& endpoints)
+      : sub_(context_, transport::SubscriberOptions{"render", endpoints}) {
+    sub_.subscribe(transport::topics::kSimWorld, [this](const v1::WorldState& ws) {
+      latest_ = ws;
+      ++received_;
+    });
+  }
+  /// Waits up to `timeout` for traffic; true when a newer state than the last call's arrived.
+  bool poll(std::chrono::microseconds timeout) {
+    sub_.poll(timeout);
+    const bool fresh = received_ != seen_;
+    seen_ = received_;
+    return fresh;
+  }
+  const v1::WorldState& latest() const { return latest_; }
+  long long received() const { return received_; }
+
+ private:
+  zmq::context_t context_;
+  transport::Subscriber sub_;
+  v1::WorldState latest_;
+  long long received_ = 0, seen_ = 0;
+};
+
 int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets) {
   int w = view.width, h = view.height;
   if (!o.size.empty()) {
@@ -108,8 +141,22 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     render::writePng((fs::path(o.out) / name).string(), ctx.read());
     ++written;
   };
-  if (o.from.empty()) {
-    // no live subscription yet: the static scene, once
+  if (!o.connect.empty()) {
+    // live: a frame per new state (every Nth), named by its arrival count, until --frames, --duration or a signal
+    LiveWorld live(o.connect);
+    const auto& stop = core::installStopSignals();
+    const auto start = std::chrono::steady_clock::now();
+    long long states = 0;
+    while (!stop.load() && (o.frames <= 0 || written < o.frames) &&
+           (o.duration <= 0 || std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < o.duration)) {
+      if (!live.poll(std::chrono::milliseconds(100))) continue;
+      const long long index = states++;
+      if (index % o.every != 0) continue;
+      addMissingModels(live.latest(), assets, tried);
+      emit(render::buildScene(live.latest(), assets, view.style), static_cast<std::size_t>(index));
+    }
+  } else if (o.from.empty()) {
+    // neither a recording nor publishers: the static scene, once
     emit(render::buildStaticScene(assets, view.style), 0);
   } else {
     const std::vector<v1::WorldState> states = readRecording(o.from);
@@ -160,6 +207,8 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
   glfwSwapInterval(1);
   std::vector<v1::WorldState> states;
   if (!o.from.empty()) states = readRecording(o.from);
+  std::unique_ptr<LiveWorld> live;
+  if (!o.connect.empty()) live = std::make_unique<LiveWorld>(o.connect);
   std::set<std::string> tried;
   int rc = core::kExitOk;
   {
@@ -195,7 +244,15 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
       render::ViewConfig v = view;
       v.orbit = orbit;
       const render::Camera cam = v.camera(w, h);
-      if (states.empty()) {
+      if (live) {
+        live->poll(std::chrono::microseconds(0));
+        if (live->received() == 0) {
+          renderer.draw(still, cam, w, h, view.background);
+        } else {
+          addMissingModels(live->latest(), assets, tried);
+          renderer.draw(render::buildScene(live->latest(), assets, view.style), cam, w, h, view.background);
+        }
+      } else if (states.empty()) {
         renderer.draw(still, cam, w, h, view.background);
       } else {  // play at the recording's sim time, looping
         const double span = std::max(1e-9, states.back().sim_time() - states.front().sim_time());
@@ -228,7 +285,11 @@ int main(int argc, char** argv) {
   app.add_option("--view", o.view, "view file (configs/views/*.yaml)")->capture_default_str();
   app.add_option("--sim", o.sim, "sim config whose scene and mannequin models to draw (configs/sim/*.yaml)");
   app.add_option("--scene", o.scene, "scene file (configs/scenes/*.yaml); overrides the sim config's");
-  app.add_option("--from", o.from, "render the sim.world messages of this MCAP recording");
+  auto* connect = app.add_option("--connect", o.connect,
+                                 "render the live sim.world of this publisher (e.g. tcp://127.0.0.1:5556; repeatable)");
+  app.add_option("--duration", o.duration, "live: stop after S seconds (0: at --frames or SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--from", o.from, "render the sim.world messages of this MCAP recording")->excludes(connect);
   app.add_flag("--headless", o.headless, "render off-screen into PNG frames (needs --out)");
   app.add_option("--size", o.size, "headless image size WIDTHxHEIGHT (default: the view's size)")
       ->check([](const std::string& s) {

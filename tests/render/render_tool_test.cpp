@@ -6,6 +6,8 @@
 #include <unistd.h>
 
 #include <array>
+#include <atomic>
+#include <thread>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -14,6 +16,8 @@
 #include "fixtures.hpp"
 #include "mannequin/proto/schema.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
+#include "mannequin/transport/publisher.hpp"
+#include "mannequin/transport/topics.hpp"
 
 namespace fs = std::filesystem;
 
@@ -136,6 +140,39 @@ TEST(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
   EXPECT_NE(rc.out.find("wrote 2 frames (160x120)"), std::string::npos) << rc.out;
   for (const fs::path& d : {a, b, c}) fs::remove_all(d);
   fs::remove(mcap);
+}
+
+TEST(RenderTool, RendersTheLiveSimWorldOfAPublisher) {
+  zmq::context_t ctx;
+  transport::Publisher pub(ctx, {"sim", {"tcp://127.0.0.1:0"}});
+  const std::string endpoint = pub.boundEndpoints().at(0);
+  std::atomic<bool> done{false};
+  std::thread publisher([&] {  // a state every 20 ms until the node has its frames (deadline: run()'s timeout)
+    const skeleton::Model model = testing::male50();
+    for (std::uint64_t i = 0; !done.load(); ++i) {
+      v1::WorldState ws;
+      ws.set_step(i);
+      math::VectorX q = skeleton::standingConfiguration(model);
+      q(1) += 0.01 * static_cast<double>(i % 50);
+      testing::addMannequin(ws, model, q, "alice");
+      pub.publish(transport::topics::kSimWorld, ws);
+      pub.poll();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  const fs::path out = temp("live");
+  const ToolRun r = run("--view configs/views/desktop.yaml --headless --size 160x120 --frames 3 --connect " + endpoint +
+                            " --out " + out.string(),
+                        "", 60);
+  done = true;
+  publisher.join();
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote 3 frames"), std::string::npos) << r.out;
+  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 3);
+  fs::remove_all(out);
+  // --from and --connect exclude each other: a usage error
+  const ToolRun both = run("--headless --out " + out.string() + " --from x.mcap --connect " + endpoint);
+  EXPECT_EQ(both.status, 2) << both.err;
 }
 
 TEST(RenderTool, OpensAWindowUnderXvfb) {
