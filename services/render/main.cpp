@@ -3,13 +3,15 @@
 //               same files); --from F.mcap renders the sim.world messages of a recording frame by frame.
 //   otherwise:  a GLFW window (needs a display); --from plays the recording at its own pace, looping.
 //   --connect:  the live sim.world of publishers (newest state; headless: a frame per new state).
-// Not yet (issue 14, later steps): the service kit (heartbeats, launcher), the swap barrier, the tracked head.
+//               A wall view with `head_body` takes its eye from that rigid body of mocap.frame (same endpoints).
+// Not yet (issue 14, later steps): the service kit (heartbeats, launcher), the swap barrier.
 #include <GLFW/glfw3.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <optional>
 #include <set>
 #include <thread>
 
@@ -92,12 +94,28 @@ std::vector<v1::WorldState> readRecording(const std::string& path) {
 /// re-sends its last state to a late subscriber, so a node shows the current scene at once).
 class LiveWorld {
  public:
-  explicit LiveWorld(const std::vector<std::string>& endpoints)
+  LiveWorld(const std::vector<std::string>& endpoints, const render::ViewConfig& view)
       : sub_(context_, transport::SubscriberOptions{"render", endpoints}) {
     sub_.subscribe(transport::topics::kSimWorld, [this](const v1::WorldState& ws) {
       latest_ = ws;
       ++received_;
     });
+    if (!view.head_body.empty())  // a wall with a tracked head: its eye follows that rigid body of mocap.frame
+      sub_.subscribe(transport::topics::kMocapFrame, [this, &view](const v1::MocapFrame& f) {
+        if (const auto h = render::trackedHead(f, view)) head_ = h;
+      });
+  }
+  /// The camera of `view` with the tracked head when there is one; a head that left the room (behind the
+  /// wall) keeps the last usable camera.
+  const render::Camera& camera(const render::ViewConfig& view, int w, int h) {
+    render::ViewConfig v = view;
+    if (head_) v.head = *head_;
+    try {
+      camera_ = v.camera(w, h);
+    } catch (const std::invalid_argument& e) {
+      if (!camera_) camera_ = view.camera(w, h);
+    }
+    return *camera_;
   }
   /// Waits up to `timeout` for traffic; true when a newer state than the last call's arrived.
   bool poll(std::chrono::microseconds timeout) {
@@ -114,6 +132,8 @@ class LiveWorld {
   transport::Subscriber sub_;
   v1::WorldState latest_;
   long long received_ = 0, seen_ = 0;
+  std::optional<render::Vec3> head_;
+  std::optional<render::Camera> camera_;
 };
 
 int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets) {
@@ -134,8 +154,8 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
   const render::Camera cam = view.camera(w, h);
   std::set<std::string> tried;
   long long written = 0;
-  const auto emit = [&](const render::RenderScene& scene, std::size_t index) {
-    renderer.draw(scene, cam, w, h, view.background);
+  const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index) {
+    renderer.draw(scene, camera, w, h, view.background);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06zu.png", index);
     render::writePng((fs::path(o.out) / name).string(), ctx.read());
@@ -143,7 +163,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
   };
   if (!o.connect.empty()) {
     // live: a frame per new state (every Nth), named by its arrival count, until --frames, --duration or a signal
-    LiveWorld live(o.connect);
+    LiveWorld live(o.connect, view);
     const auto& stop = core::installStopSignals();
     const auto start = std::chrono::steady_clock::now();
     long long states = 0;
@@ -153,11 +173,11 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       const long long index = states++;
       if (index % o.every != 0) continue;
       addMissingModels(live.latest(), assets, tried);
-      emit(render::buildScene(live.latest(), assets, view.style), static_cast<std::size_t>(index));
+      emit(render::buildScene(live.latest(), assets, view.style), live.camera(view, w, h), static_cast<std::size_t>(index));
     }
   } else if (o.from.empty()) {
     // neither a recording nor publishers: the static scene, once
-    emit(render::buildStaticScene(assets, view.style), 0);
+    emit(render::buildStaticScene(assets, view.style), cam, 0);
   } else {
     const std::vector<v1::WorldState> states = readRecording(o.from);
     if (states.empty()) {
@@ -167,7 +187,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     for (std::size_t i = 0; i < states.size(); i += static_cast<std::size_t>(o.every)) {
       if (o.frames > 0 && written >= o.frames) break;
       addMissingModels(states[i], assets, tried);
-      emit(render::buildScene(states[i], assets, view.style), i);
+      emit(render::buildScene(states[i], assets, view.style), cam, i);
     }
   }
   std::printf("wrote %lld frames (%dx%d) to %s\n", written, w, h, o.out.c_str());
@@ -208,7 +228,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
   std::vector<v1::WorldState> states;
   if (!o.from.empty()) states = readRecording(o.from);
   std::unique_ptr<LiveWorld> live;
-  if (!o.connect.empty()) live = std::make_unique<LiveWorld>(o.connect);
+  if (!o.connect.empty()) live = std::make_unique<LiveWorld>(o.connect, view);
   std::set<std::string> tried;
   int rc = core::kExitOk;
   {
@@ -243,9 +263,9 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
       glfwGetFramebufferSize(win, &w, &h);
       render::ViewConfig v = view;
       v.orbit = orbit;
-      const render::Camera cam = v.camera(w, h);
+      if (live) live->poll(std::chrono::microseconds(0));
+      const render::Camera cam = live ? live->camera(v, w, h) : v.camera(w, h);
       if (live) {
-        live->poll(std::chrono::microseconds(0));
         if (live->received() == 0) {
           renderer.draw(still, cam, w, h, view.background);
         } else {

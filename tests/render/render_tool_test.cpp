@@ -175,6 +175,61 @@ TEST(RenderTool, RendersTheLiveSimWorldOfAPublisher) {
   EXPECT_EQ(both.status, 2) << both.err;
 }
 
+TEST(RenderTool, AWallWithATrackedHeadDrawsWhatAFixedHeadThereDraws) {
+  // the same wall twice: a fixed head at E, and head_body "head" tracked at E by mocap.frame
+  const std::string wall =
+      "type: wall\nsize: [96, 96]\nwall: {lower_left: [1.5, 1.5, 0], lower_right: [1.5, -1.5, 0], upper_left: [1.5, 1.5, 3]}\n";
+  const fs::path fixed = temp("fixed.yaml"), tracked = temp("tracked.yaml");
+  std::ofstream(fixed) << wall << "head: [0.4, -0.3, 1.5]\n";
+  std::ofstream(tracked) << wall << "head: [0, 0, 1.7]\nhead_body: head\n";
+  zmq::context_t ctx;
+  transport::Publisher pub(ctx, {"sim", {"tcp://127.0.0.1:0"}});
+  const std::string endpoint = pub.boundEndpoints().at(0);
+  std::atomic<bool> done{false};
+  const skeleton::Model model = testing::male50();
+  v1::WorldState ws;
+  math::VectorX q = skeleton::standingConfiguration(model);
+  q(0) = 0.8;  // in front of the viewer, before the wall
+  testing::addMannequin(ws, model, q, "alice");
+  std::thread publisher([&] {
+    while (!done.load()) {
+      v1::MocapFrame f;
+      v1::RigidBody* b = f.add_bodies();
+      b->set_name("head");
+      b->set_tracked(true);
+      testing::toMsg(SE3(math::Matrix3::Identity(), Vector3(0.4, -0.3, 1.5)), *b->mutable_pose());
+      pub.publish(transport::topics::kMocapFrame, f);
+      v1::WorldState w = ws;
+      pub.publish(transport::topics::kSimWorld, w);
+      pub.poll();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  const fs::path live = temp("tracked_out"), ref = temp("fixed_out");
+  const ToolRun r = run("--view " + tracked.string() + " --headless --frames 4 --connect " + endpoint + " --out " + live.string(), "", 60);
+  done = true;
+  publisher.join();
+  ASSERT_EQ(r.status, 0) << r.err;
+  const fs::path mcap = temp("one.mcap");
+  {
+    recording::McapWriter w(mcap.string());
+    const auto schema = w.addSchema("mannequin.v1.WorldState", "protobuf", proto::fileDescriptorSet(v1::WorldState::descriptor()));
+    const auto ch = w.addChannel("sim.world", schema, "protobuf");
+    w.write(ch, 1, 0, 0, ws.SerializeAsString());
+    w.close();
+  }
+  const ToolRun rr = run("--view " + fixed.string() + " --headless --from " + mcap.string() + " --out " + ref.string());
+  ASSERT_EQ(rr.status, 0) << rr.err;
+  std::vector<fs::path> frames;
+  for (const auto& e : fs::directory_iterator(live)) frames.push_back(e.path());
+  std::sort(frames.begin(), frames.end());
+  ASSERT_EQ(frames.size(), 4u);
+  // the last live frame (mocap arrived long before) is the fixed-head frame, byte for byte
+  EXPECT_EQ(slurp(frames.back()), slurp(ref / "frame_000000.png"));
+  for (const fs::path& p : {fixed, tracked, mcap}) fs::remove(p);
+  for (const fs::path& d : {live, ref}) fs::remove_all(d);
+}
+
 TEST(RenderTool, OpensAWindowUnderXvfb) {
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); the window path is not tested";

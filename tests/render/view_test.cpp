@@ -6,6 +6,7 @@
 #include "fixtures.hpp"
 #include "mannequin/core/config.hpp"
 #include "mannequin/render/view.hpp"
+#include "mannequin/v1/mocap.pb.h"
 
 namespace mannequin::render {
 namespace {
@@ -69,6 +70,37 @@ TEST(ViewConfig, ErrorsNameFileLineAndKey) {
   } catch (const core::ConfigError& e) {
     EXPECT_NE(std::string(e.what()).find("/nonexistent/view.yaml"), std::string::npos) << e.what();
   }
+}
+
+TEST(ViewConfig, TrackedHeadIsTheHeadBodysPoseTimesTheOffset) {
+  const ViewConfig v = parseView(
+      "type: wall\nwall: {lower_left: [1.5, 1.5, 0], lower_right: [1.5, -1.5, 0], upper_left: [1.5, 1.5, 3]}\n"
+      "head_body: head\nhead_offset: [0.1, 0, 0.05]\n",
+      "v.yaml");
+  EXPECT_EQ(v.head_body, "head");
+  v1::MocapFrame f;
+  v1::RigidBody* other = f.add_bodies();
+  other->set_name("hand_l");
+  other->set_tracked(true);
+  EXPECT_FALSE(trackedHead(f, v).has_value());  // no head body in the frame
+  v1::RigidBody* h = f.add_bodies();
+  h->set_name("head");
+  h->set_tracked(false);
+  h->mutable_pose()->mutable_position()->set_z(1.6);
+  EXPECT_FALSE(trackedHead(f, v).has_value());  // occluded: keep the previous head
+  h->set_tracked(true);
+  // rotated 90° about z: the body's x offset becomes +y in the room
+  const double c = std::sqrt(0.5);
+  h->mutable_pose()->mutable_orientation()->set_w(c);
+  h->mutable_pose()->mutable_orientation()->set_z(c);
+  h->mutable_pose()->mutable_position()->set_x(0.2);
+  const auto eye = trackedHead(f, v);
+  ASSERT_TRUE(eye.has_value());
+  EXPECT_LT((*eye - Vec3(0.2, 0.1, 1.65)).norm(), 1e-12);
+  // a desktop view has no head
+  EXPECT_NE(errorOf("type: desktop\nhead_body: head\n").find("head_body"), std::string::npos);
+  ViewConfig d;
+  EXPECT_FALSE(trackedHead(f, d).has_value());
 }
 
 }  // namespace

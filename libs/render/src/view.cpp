@@ -4,7 +4,10 @@
 #include <numbers>
 #include <stdexcept>
 
+#include <Eigen/Geometry>
+
 #include "mannequin/core/config.hpp"
+#include "mannequin/v1/mocap.pb.h"
 
 namespace mannequin::render {
 
@@ -14,7 +17,8 @@ constexpr double kDeg = std::numbers::pi / 180.0;
 ViewConfig fromNode(const core::ConfigNode& root) {
   ViewConfig v;
   v.source = root.file();
-  root.allowOnly({"name", "type", "size", "background", "camera", "wall", "head", "near", "far", "style"});
+  root.allowOnly({"name", "type", "size", "background", "camera", "wall", "head", "head_body", "head_offset", "near",
+                  "far", "style"});
   v.name = root.get("name", v.name);
   if (!root.has("type")) root.fail("missing key 'type' (desktop or wall)");
   v.type = root["type"].choice({"desktop", "wall"}) == 0 ? ViewConfig::Type::kDesktop : ViewConfig::Type::kWall;
@@ -38,7 +42,7 @@ ViewConfig fromNode(const core::ConfigNode& root) {
     if (auto f = s->find("force_full")) v.style.force_full = f->positive();
   }
   if (v.type == ViewConfig::Type::kDesktop) {
-    for (const char* k : {"wall", "head", "near", "far"})
+    for (const char* k : {"wall", "head", "head_body", "head_offset", "near", "far"})
       if (root.has(k)) root[k].fail("only a wall view has this key (type: wall)");
     if (auto c = root.find("camera")) {
       c->allowOnly({"target", "distance", "yaw_deg", "pitch_deg", "fov_y_deg", "near", "far"});
@@ -60,6 +64,11 @@ ViewConfig fromNode(const core::ConfigNode& root) {
     v.wall.lower_right = w["lower_right"].vec3();
     v.wall.upper_left = w["upper_left"].vec3();
     if (auto h = root.find("head")) v.head = h->vec3();
+    if (auto h = root.find("head_body")) {
+      v.head_body = h->str();
+      if (v.head_body.empty()) h->fail("expected a rigid body name of mocap.frame");
+    }
+    if (auto h = root.find("head_offset")) v.head_offset = h->vec3();
     if (auto t = root.find("near")) v.near_plane = t->positive();
     if (auto t = root.find("far")) v.far_plane = t->positive();
     if (v.far_plane <= v.near_plane) root["far"].fail("far must be greater than near");
@@ -76,6 +85,21 @@ ViewConfig fromNode(const core::ConfigNode& root) {
 Camera ViewConfig::camera(int image_width, int image_height) const {
   if (type == Type::kWall) return wallCamera(wall, head, near_plane, far_plane);
   return orbit.camera(static_cast<double>(image_width) / std::max(1, image_height));
+}
+
+std::optional<Vec3> trackedHead(const v1::MocapFrame& frame, const ViewConfig& view) {
+  if (view.head_body.empty()) return std::nullopt;
+  for (const v1::RigidBody& b : frame.bodies()) {
+    if (b.name() != view.head_body || !b.tracked()) continue;
+    const auto& p = b.pose().position();
+    const auto& o = b.pose().orientation();
+    Eigen::Quaterniond q(o.w(), o.x(), o.y(), o.z());
+    if (!(q.norm() > 1e-9)) q = Eigen::Quaterniond::Identity();
+    const Vec3 eye = Vec3(p.x(), p.y(), p.z()) + q.normalized() * view.head_offset;
+    if (!eye.allFinite()) return std::nullopt;
+    return eye;
+  }
+  return std::nullopt;
 }
 
 ViewConfig parseView(const std::string& yaml_text, const std::string& source) {

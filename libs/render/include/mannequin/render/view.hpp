@@ -13,16 +13,23 @@
 /// type: wall
 /// size: [1280, 720]
 /// wall: {lower_left: [1.5, 1.2, 0.0], lower_right: [1.5, -1.2, 0.0], upper_left: [1.5, 1.2, 1.35]}   # room = world, m
-/// head: [0, 0, 1.7]             # head position until a tracked head (mocap.frame rigid body) drives it
+/// head: [0, 0, 1.7]             # the eye; with head_body, until that body is first tracked
+/// head_body: head               # optional: the mocap.frame rigid body that carries the eye (live, --connect)
+/// head_offset: [0.0, 0.0, 0.08] # optional: the eye in that body's frame (m)
 /// near: 0.05
 /// far: 100
 /// ```
 /// Optional in both: `style: {force_scale: 0.002, force_full: 400}` (m per N, N at full red).
 #include <array>
+#include <optional>
 #include <string>
 
 #include "mannequin/render/camera.hpp"
 #include "mannequin/render/scene.hpp"
+
+namespace mannequin::v1 {
+class MocapFrame;
+}
 
 namespace mannequin::render {
 
@@ -35,7 +42,9 @@ struct ViewConfig {
   std::array<float, 3> background{0.11f, 0.12f, 0.14f};
   OrbitCamera orbit;           ///< kDesktop
   Wall wall;                   ///< kWall
-  Vec3 head{0.0, 0.0, 1.7};    ///< kWall
+  Vec3 head{0.0, 0.0, 1.7};    ///< kWall: the eye (room = world, m)
+  std::string head_body;       ///< kWall: the mocap.frame rigid body carrying the eye ("" : the head is fixed)
+  Vec3 head_offset = Vec3::Zero();  ///< kWall: the eye in head_body's frame (m)
   double near_plane = 0.05, far_plane = 100.0;  ///< kWall (the orbit camera has its own)
   Style style;
 
@@ -48,6 +57,10 @@ struct ViewConfig {
 /// whose edges are not orthogonal, a head behind the wall).
 ViewConfig parseView(const std::string& yaml_text, const std::string& source);
 ViewConfig loadView(const std::string& path);
+
+/// The eye position from a mocap frame: head_body's pose · head_offset, when the view has a head_body and
+/// the frame has that body tracked with a finite pose; nullopt otherwise (keep the previous head).
+std::optional<Vec3> trackedHead(const v1::MocapFrame& frame, const ViewConfig& view);
 
 /// "1280x720" → (1280, 720). \throws std::invalid_argument naming the text.
 std::array<int, 2> parseSize(const std::string& text);
