@@ -1,0 +1,104 @@
+#pragma once
+/// \file renderer.hpp
+/// \brief OpenGL 3.3 core renderer of a RenderScene, and the off-screen (headless) context.
+///
+/// OpenGL entry points come from the system's libGL/libOpenGL (Mesa exports every GL 3.3 function;
+/// GL_GLEXT_PROTOTYPES), so there is no loader. The Renderer draws into whatever context and framebuffer
+/// are current (a GLFW window, or the HeadlessContext's FBO).
+///
+/// Headless: EGL on Mesa's "surfaceless" platform (EGL_MESA_platform_surfaceless) with a configless
+/// OpenGL 3.3 core context and an FBO (RGBA8 colour + 24-bit depth renderbuffers). It needs no X server
+/// and no DISPLAY, so tests and `--headless` run the same on a build host, in CI and under a desktop session;
+/// with no GPU, Mesa answers with llvmpipe (software). Rendering is deterministic for a given Mesa build.
+#include <array>
+#include <cstdint>
+#include <map>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mannequin/render/camera.hpp"
+#include "mannequin/render/scene.hpp"
+
+namespace mannequin::render {
+
+/// A failure of the OpenGL or EGL layer (no context, a shader that does not compile, an incomplete FBO).
+class RenderError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+/// An 8-bit RGB image, rows from the TOP.
+struct Image {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> rgb;  ///< 3 · width · height
+  std::array<std::uint8_t, 3> at(int x, int y) const {
+    const std::size_t i = 3 * (static_cast<std::size_t>(y) * static_cast<std::size_t>(width) + static_cast<std::size_t>(x));
+    return {rgb[i], rgb[i + 1], rgb[i + 2]};
+  }
+};
+
+/// Writes an 8-bit RGB PNG (libpng). \throws RenderError naming the file.
+void writePng(const std::string& path, const Image& image);
+
+/// Draws RenderScenes with a camera into the current GL context. Build it with the context current;
+/// destroy it with the same context current.
+class Renderer {
+ public:
+  /// Compiles the shaders and uploads the unit meshes. \throws RenderError (no current context, GL < 3.3).
+  Renderer();
+  ~Renderer();
+  Renderer(const Renderer&) = delete;
+  Renderer& operator=(const Renderer&) = delete;
+
+  /// Clears the current framebuffer's viewport (0, 0, width, height) to `background` and draws the scene.
+  void draw(const RenderScene& scene, const Camera& camera, int width, int height,
+            const std::array<float, 3>& background);
+
+  /// GL_RENDERER and GL_VERSION of the current context ("llvmpipe (LLVM 15.0.6, 256 bits) | 4.5 (Core Profile) Mesa ...").
+  static std::string describeContext();
+
+ private:
+  struct Mesh {
+    unsigned vao = 0, vbo = 0;
+    int count = 0;
+  };
+  Mesh upload(const std::vector<float>& interleaved);  // x y z nx ny nz per vertex, triangles
+  void drawMesh(const Mesh& mesh, const Eigen::Matrix4d& model, const Colour& colour);
+  const Mesh& meshFor(const collision::TriangleMesh& m);
+
+  unsigned program_ = 0;
+  int u_mvp_ = -1, u_normal_ = -1, u_colour_ = -1, u_unlit_ = -1, u_light_ = -1;
+  Mesh sphere_, cylinder_, cone_, box_, quad_;
+  unsigned line_vao_ = 0, line_vbo_ = 0;
+  std::map<const collision::TriangleMesh*, Mesh> meshes_;
+  Eigen::Matrix4d view_proj_ = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d view_ = Eigen::Matrix4d::Identity();
+};
+
+/// An off-screen OpenGL 3.3 core context with a width × height framebuffer (see the file comment).
+/// Current on the constructing thread after construction.
+class HeadlessContext {
+ public:
+  /// \throws RenderError saying what is missing (no EGL surfaceless platform, no GL 3.3 core, FBO incomplete).
+  HeadlessContext(int width, int height);
+  ~HeadlessContext();
+  HeadlessContext(const HeadlessContext&) = delete;
+  HeadlessContext& operator=(const HeadlessContext&) = delete;
+
+  int width() const { return width_; }
+  int height() const { return height_; }
+  /// Makes the context current and binds its framebuffer.
+  void makeCurrent();
+  /// The framebuffer's pixels (after glFinish), rows from the top.
+  Image read() const;
+
+ private:
+  int width_, height_;
+  void* display_ = nullptr;
+  void* context_ = nullptr;
+  unsigned fbo_ = 0, colour_ = 0, depth_ = 0;
+};
+
+}  // namespace mannequin::render

@@ -1,0 +1,68 @@
+#pragma once
+/// \file view.hpp
+/// \brief View files (configs/views/*.yaml): what one render node shows. Reference in docs/render.md.
+///
+/// ```yaml
+/// name: desktop
+/// type: desktop                 # desktop (orbit camera) | wall (off-axis frustum of a VR wall)
+/// size: [1280, 720]             # window / default headless size (pixels)
+/// background: [0.11, 0.12, 0.14]
+/// camera: {target: [0.4, 0, 0.9], distance: 3.6, yaw_deg: 35, pitch_deg: 18, fov_y_deg: 45, near: 0.05, far: 100}
+/// ---
+/// name: wall_front
+/// type: wall
+/// size: [1280, 720]
+/// wall: {lower_left: [1.5, 1.2, 0.0], lower_right: [1.5, -1.2, 0.0], upper_left: [1.5, 1.2, 1.35]}   # room = world, m
+/// head: [0, 0, 1.7]             # the eye; with head_body, until that body is first tracked
+/// head_body: head               # optional: the mocap.frame rigid body that carries the eye (live, --connect)
+/// head_offset: [0.0, 0.0, 0.08] # optional: the eye in that body's frame (m)
+/// near: 0.05
+/// far: 100
+/// ```
+/// Optional in both: `style: {force_scale: 0.002, force_full: 400}` (m per N, N at full red).
+#include <array>
+#include <optional>
+#include <string>
+
+#include "mannequin/render/camera.hpp"
+#include "mannequin/render/scene.hpp"
+
+namespace mannequin::v1 {
+class MocapFrame;
+}
+
+namespace mannequin::render {
+
+struct ViewConfig {
+  enum class Type { kDesktop, kWall };
+  std::string name = "view";
+  std::string source;          ///< file it was read from
+  Type type = Type::kDesktop;
+  int width = 1280, height = 720;
+  std::array<float, 3> background{0.11f, 0.12f, 0.14f};
+  OrbitCamera orbit;           ///< kDesktop
+  Wall wall;                   ///< kWall
+  Vec3 head{0.0, 0.0, 1.7};    ///< kWall: the eye (room = world, m)
+  std::string head_body;       ///< kWall: the mocap.frame rigid body carrying the eye ("" : the head is fixed)
+  Vec3 head_offset = Vec3::Zero();  ///< kWall: the eye in head_body's frame (m)
+  double near_plane = 0.05, far_plane = 100.0;  ///< kWall (the orbit camera has its own)
+  Style style;
+
+  /// The camera of this view for an image of width × height (desktop: the orbit camera at that aspect;
+  /// wall: the off-axis frustum from `head`, independent of the image size).
+  Camera camera(int image_width, int image_height) const;
+};
+
+/// \throws core::ConfigError "FILE:LINE: field 'camera.distance': ..." (unknown key, bad value, a wall
+/// whose edges are not orthogonal, a head behind the wall).
+ViewConfig parseView(const std::string& yaml_text, const std::string& source);
+ViewConfig loadView(const std::string& path);
+
+/// The eye position from a mocap frame: head_body's pose · head_offset, when the view has a head_body and
+/// the frame has that body tracked with a finite pose; nullopt otherwise (keep the previous head).
+std::optional<Vec3> trackedHead(const v1::MocapFrame& frame, const ViewConfig& view);
+
+/// "1280x720" → (1280, 720). \throws std::invalid_argument naming the text.
+std::array<int, 2> parseSize(const std::string& text);
+
+}  // namespace mannequin::render

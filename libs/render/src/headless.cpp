@@ -1,0 +1,101 @@
+#define GL_GLEXT_PROTOTYPES 1
+#include <EGL/egl.h>
+#include <EGL/eglext.h>
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <cstring>
+
+#include "mannequin/render/renderer.hpp"
+
+namespace mannequin::render {
+
+namespace {
+std::string eglErr(const char* what) {
+  char buf[96];
+  std::snprintf(buf, sizeof buf, "%s failed (EGL error 0x%04x)", what, static_cast<unsigned>(eglGetError()));
+  return buf;
+}
+}  // namespace
+
+HeadlessContext::HeadlessContext(int width, int height) : width_(width), height_(height) {
+  if (width < 1 || height < 1 || width > 16384 || height > 16384)
+    throw RenderError("headless: size " + std::to_string(width) + "x" + std::to_string(height) + " out of [1, 16384]");
+  const char* client = eglQueryString(EGL_NO_DISPLAY, EGL_EXTENSIONS);
+  if (client == nullptr || std::strstr(client, "EGL_MESA_platform_surfaceless") == nullptr)
+    throw RenderError(
+        "headless: EGL has no surfaceless platform (EGL_MESA_platform_surfaceless); install Mesa's EGL "
+        "(tools/setup: libegl-mesa0 libgl1-mesa-dri)");
+  EGLDisplay dpy = eglGetPlatformDisplay(EGL_PLATFORM_SURFACELESS_MESA, EGL_DEFAULT_DISPLAY, nullptr);
+  if (dpy == EGL_NO_DISPLAY) throw RenderError("headless: " + eglErr("eglGetPlatformDisplay(surfaceless)"));
+  EGLint major = 0, minor = 0;
+  if (!eglInitialize(dpy, &major, &minor)) throw RenderError("headless: " + eglErr("eglInitialize"));
+  display_ = dpy;
+  if (!eglBindAPI(EGL_OPENGL_API)) throw RenderError("headless: " + eglErr("eglBindAPI(OpenGL)"));
+  const EGLint attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 3, EGL_CONTEXT_MINOR_VERSION, 3, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+                            EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
+  EGLContext ctx = eglCreateContext(dpy, EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, attribs);
+  if (ctx == EGL_NO_CONTEXT) {
+    eglTerminate(dpy);
+    throw RenderError("headless: " + eglErr("eglCreateContext(OpenGL 3.3 core, no config)"));
+  }
+  context_ = ctx;
+  if (!eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, ctx)) {
+    eglDestroyContext(dpy, ctx);
+    eglTerminate(dpy);
+    throw RenderError("headless: " + eglErr("eglMakeCurrent(no surface)"));
+  }
+  glGenFramebuffers(1, &fbo_);
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+  glGenRenderbuffers(1, &colour_);
+  glBindRenderbuffer(GL_RENDERBUFFER, colour_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_RGBA8, width, height);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_COLOR_ATTACHMENT0, GL_RENDERBUFFER, colour_);
+  glGenRenderbuffers(1, &depth_);
+  glBindRenderbuffer(GL_RENDERBUFFER, depth_);
+  glRenderbufferStorage(GL_RENDERBUFFER, GL_DEPTH_COMPONENT24, width, height);
+  glFramebufferRenderbuffer(GL_FRAMEBUFFER, GL_DEPTH_ATTACHMENT, GL_RENDERBUFFER, depth_);
+  const GLenum status = glCheckFramebufferStatus(GL_FRAMEBUFFER);
+  if (status != GL_FRAMEBUFFER_COMPLETE) {
+    char buf[64];
+    std::snprintf(buf, sizeof buf, "0x%04x", status);
+    throw RenderError(std::string("headless: framebuffer incomplete (") + buf + ")");
+  }
+}
+
+HeadlessContext::~HeadlessContext() {
+  auto* dpy = static_cast<EGLDisplay>(display_);
+  if (context_ != nullptr) {
+    eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, static_cast<EGLContext>(context_));
+    if (depth_) glDeleteRenderbuffers(1, &depth_);
+    if (colour_) glDeleteRenderbuffers(1, &colour_);
+    if (fbo_) glDeleteFramebuffers(1, &fbo_);
+    eglMakeCurrent(dpy, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
+    eglDestroyContext(dpy, static_cast<EGLContext>(context_));
+  }
+  // the display is not terminated: EGL displays are per process and shared by every context on them
+}
+
+void HeadlessContext::makeCurrent() {
+  eglMakeCurrent(static_cast<EGLDisplay>(display_), EGL_NO_SURFACE, EGL_NO_SURFACE, static_cast<EGLContext>(context_));
+  glBindFramebuffer(GL_FRAMEBUFFER, fbo_);
+}
+
+Image HeadlessContext::read() const {
+  glFinish();
+  glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
+  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  Image img;
+  img.width = width_;
+  img.height = height_;
+  std::vector<std::uint8_t> raw(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 3);
+  glReadPixels(0, 0, width_, height_, GL_RGB, GL_UNSIGNED_BYTE, raw.data());
+  img.rgb.resize(raw.size());
+  const std::size_t row = static_cast<std::size_t>(width_) * 3;
+  for (int y = 0; y < height_; ++y)  // GL rows are bottom-up
+    std::memcpy(img.rgb.data() + static_cast<std::size_t>(y) * row,
+                raw.data() + static_cast<std::size_t>(height_ - 1 - y) * row, row);
+  return img;
+}
+
+}  // namespace mannequin::render

@@ -1,0 +1,301 @@
+#define GL_GLEXT_PROTOTYPES 1
+#include "mannequin/render/renderer.hpp"
+
+#include <GL/gl.h>
+#include <GL/glext.h>
+
+#include <cmath>
+#include <numbers>
+
+#include <Eigen/Geometry>
+#include <Eigen/LU>
+
+namespace mannequin::render {
+
+namespace {
+
+const char* kVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_pos;
+layout(location = 1) in vec3 a_normal;
+uniform mat4 u_mvp;
+uniform mat3 u_normal;   // view-space normal matrix
+out vec3 v_normal;
+void main() {
+  v_normal = u_normal * a_normal;
+  gl_Position = u_mvp * vec4(a_pos, 1.0);
+}
+)";
+
+const char* kFragment = R"(#version 330 core
+in vec3 v_normal;
+uniform vec4 u_colour;
+uniform int u_unlit;
+uniform vec3 u_light;    // view space, unit, towards the light
+out vec4 frag;
+void main() {
+  if (u_unlit != 0) { frag = u_colour; return; }
+  float d = abs(dot(normalize(v_normal), u_light));   // two-sided headlight
+  frag = vec4(u_colour.rgb * (0.35 + 0.65 * d), u_colour.a);
+}
+)";
+
+unsigned compile(GLenum type, const char* src) {
+  const GLuint s = glCreateShader(type);
+  glShaderSource(s, 1, &src, nullptr);
+  glCompileShader(s);
+  GLint ok = 0;
+  glGetShaderiv(s, GL_COMPILE_STATUS, &ok);
+  if (!ok) {
+    char log[2048];
+    glGetShaderInfoLog(s, sizeof log, nullptr, log);
+    throw RenderError(std::string("shader compile failed: ") + log);
+  }
+  return s;
+}
+
+void push(std::vector<float>& v, const Eigen::Vector3d& p, const Eigen::Vector3d& n) {
+  for (int i = 0; i < 3; ++i) v.push_back(static_cast<float>(p[i]));
+  for (int i = 0; i < 3; ++i) v.push_back(static_cast<float>(n[i]));
+}
+
+// unit sphere (radius 1)
+std::vector<float> sphereMesh(int slices = 24, int stacks = 14) {
+  std::vector<float> v;
+  const double pi = std::numbers::pi;
+  auto pt = [&](int i, int j) {
+    const double th = pi * i / stacks, ph = 2 * pi * j / slices;
+    return Eigen::Vector3d(std::sin(th) * std::cos(ph), std::sin(th) * std::sin(ph), std::cos(th));
+  };
+  for (int i = 0; i < stacks; ++i)
+    for (int j = 0; j < slices; ++j) {
+      const auto a = pt(i, j), b = pt(i + 1, j), c = pt(i + 1, j + 1), d = pt(i, j + 1);
+      push(v, a, a); push(v, b, b); push(v, c, c);
+      push(v, a, a); push(v, c, c); push(v, d, d);
+    }
+  return v;
+}
+
+// cylinder radius 1, z ∈ [−0.5, 0.5], with caps
+std::vector<float> cylinderMesh(int slices = 24) {
+  std::vector<float> v;
+  const double pi = std::numbers::pi;
+  for (int j = 0; j < slices; ++j) {
+    const double a0 = 2 * pi * j / slices, a1 = 2 * pi * (j + 1) / slices;
+    const Eigen::Vector3d n0(std::cos(a0), std::sin(a0), 0), n1(std::cos(a1), std::sin(a1), 0);
+    const Eigen::Vector3d lo(0, 0, -0.5), hi(0, 0, 0.5);
+    push(v, n0 + lo, n0); push(v, n1 + lo, n1); push(v, n1 + hi, n1);
+    push(v, n0 + lo, n0); push(v, n1 + hi, n1); push(v, n0 + hi, n0);
+    push(v, hi, Eigen::Vector3d::UnitZ()); push(v, n0 + hi, Eigen::Vector3d::UnitZ()); push(v, n1 + hi, Eigen::Vector3d::UnitZ());
+    push(v, lo, -Eigen::Vector3d::UnitZ()); push(v, n1 + lo, -Eigen::Vector3d::UnitZ()); push(v, n0 + lo, -Eigen::Vector3d::UnitZ());
+  }
+  return v;
+}
+
+// cone: base radius 1 at z = 0, apex at z = 1, with its base cap
+std::vector<float> coneMesh(int slices = 24) {
+  std::vector<float> v;
+  const double pi = std::numbers::pi;
+  const Eigen::Vector3d apex(0, 0, 1);
+  for (int j = 0; j < slices; ++j) {
+    const double a0 = 2 * pi * j / slices, a1 = 2 * pi * (j + 1) / slices;
+    const Eigen::Vector3d p0(std::cos(a0), std::sin(a0), 0), p1(std::cos(a1), std::sin(a1), 0);
+    const Eigen::Vector3d n0 = Eigen::Vector3d(p0.x(), p0.y(), 1).normalized(), n1 = Eigen::Vector3d(p1.x(), p1.y(), 1).normalized();
+    push(v, p0, n0); push(v, p1, n1); push(v, apex, (n0 + n1).normalized());
+    push(v, Eigen::Vector3d::Zero(), -Eigen::Vector3d::UnitZ()); push(v, p1, -Eigen::Vector3d::UnitZ()); push(v, p0, -Eigen::Vector3d::UnitZ());
+  }
+  return v;
+}
+
+// cube [−0.5, 0.5]³
+std::vector<float> boxMesh() {
+  std::vector<float> v;
+  for (int axis = 0; axis < 3; ++axis)
+    for (int s = -1; s <= 1; s += 2) {
+      Eigen::Vector3d n = Eigen::Vector3d::Zero();
+      n[axis] = s;
+      const Eigen::Vector3d u = Eigen::Vector3d::Unit((axis + 1) % 3), w = Eigen::Vector3d::Unit((axis + 2) % 3);
+      const Eigen::Vector3d c = 0.5 * n;
+      const Eigen::Vector3d a = c - 0.5 * u - 0.5 * w, b = c + 0.5 * u - 0.5 * w, cc = c + 0.5 * u + 0.5 * w,
+                            d = c - 0.5 * u + 0.5 * w;
+      push(v, a, n); push(v, b, n); push(v, cc, n);
+      push(v, a, n); push(v, cc, n); push(v, d, n);
+    }
+  return v;
+}
+
+// square [−0.5, 0.5]² at z = 0, normal +z
+std::vector<float> quadMesh() {
+  std::vector<float> v;
+  const Eigen::Vector3d n = Eigen::Vector3d::UnitZ();
+  push(v, {-0.5, -0.5, 0}, n); push(v, {0.5, -0.5, 0}, n); push(v, {0.5, 0.5, 0}, n);
+  push(v, {-0.5, -0.5, 0}, n); push(v, {0.5, 0.5, 0}, n); push(v, {-0.5, 0.5, 0}, n);
+  return v;
+}
+
+Eigen::Matrix4d poseMatrix(const SE3& pose, const Eigen::Vector3d& scale) {
+  Eigen::Matrix4d m = Eigen::Matrix4d::Identity();
+  m.block<3, 3>(0, 0) = pose.R * scale.asDiagonal();
+  m.block<3, 1>(0, 3) = pose.p;
+  return m;
+}
+
+}  // namespace
+
+std::string Renderer::describeContext() {
+  const auto* r = glGetString(GL_RENDERER);
+  const auto* v = glGetString(GL_VERSION);
+  return std::string(r ? reinterpret_cast<const char*>(r) : "?") + " | " + (v ? reinterpret_cast<const char*>(v) : "?");
+}
+
+Renderer::Renderer() {
+  GLint major = 0, minor = 0;
+  glGetIntegerv(GL_MAJOR_VERSION, &major);
+  glGetIntegerv(GL_MINOR_VERSION, &minor);
+  if (major * 10 + minor < 33)
+    throw RenderError("OpenGL 3.3 core is needed; the current context is " + describeContext());
+  const unsigned vs = compile(GL_VERTEX_SHADER, kVertex), fs = compile(GL_FRAGMENT_SHADER, kFragment);
+  program_ = glCreateProgram();
+  glAttachShader(program_, vs);
+  glAttachShader(program_, fs);
+  glLinkProgram(program_);
+  glDeleteShader(vs);
+  glDeleteShader(fs);
+  GLint ok = 0;
+  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
+  if (!ok) throw RenderError("shader link failed");
+  u_mvp_ = glGetUniformLocation(program_, "u_mvp");
+  u_normal_ = glGetUniformLocation(program_, "u_normal");
+  u_colour_ = glGetUniformLocation(program_, "u_colour");
+  u_unlit_ = glGetUniformLocation(program_, "u_unlit");
+  u_light_ = glGetUniformLocation(program_, "u_light");
+  sphere_ = upload(sphereMesh());
+  cylinder_ = upload(cylinderMesh());
+  cone_ = upload(coneMesh());
+  box_ = upload(boxMesh());
+  quad_ = upload(quadMesh());
+  glGenVertexArrays(1, &line_vao_);
+  glGenBuffers(1, &line_vbo_);
+  glBindVertexArray(line_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, line_vbo_);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<void*>(3 * sizeof(float)));
+  glBindVertexArray(0);
+}
+
+Renderer::~Renderer() {
+  auto drop = [](Mesh& m) {
+    if (m.vbo) glDeleteBuffers(1, &m.vbo);
+    if (m.vao) glDeleteVertexArrays(1, &m.vao);
+  };
+  drop(sphere_); drop(cylinder_); drop(cone_); drop(box_); drop(quad_);
+  for (auto& [k, m] : meshes_) drop(m);
+  if (line_vbo_) glDeleteBuffers(1, &line_vbo_);
+  if (line_vao_) glDeleteVertexArrays(1, &line_vao_);
+  if (program_) glDeleteProgram(program_);
+}
+
+Renderer::Mesh Renderer::upload(const std::vector<float>& data) {
+  Mesh m;
+  glGenVertexArrays(1, &m.vao);
+  glGenBuffers(1, &m.vbo);
+  glBindVertexArray(m.vao);
+  glBindBuffer(GL_ARRAY_BUFFER, m.vbo);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(data.size() * sizeof(float)), data.data(), GL_STATIC_DRAW);
+  glEnableVertexAttribArray(0);
+  glVertexAttribPointer(0, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), nullptr);
+  glEnableVertexAttribArray(1);
+  glVertexAttribPointer(1, 3, GL_FLOAT, GL_FALSE, 6 * sizeof(float), reinterpret_cast<void*>(3 * sizeof(float)));
+  glBindVertexArray(0);
+  m.count = static_cast<int>(data.size() / 6);
+  return m;
+}
+
+const Renderer::Mesh& Renderer::meshFor(const collision::TriangleMesh& tm) {
+  if (auto it = meshes_.find(&tm); it != meshes_.end()) return it->second;
+  std::vector<float> v;
+  v.reserve(tm.triangles.size() * 18);
+  for (const auto& t : tm.triangles) {
+    const Eigen::Vector3d a = tm.vertices[static_cast<std::size_t>(t[0])], b = tm.vertices[static_cast<std::size_t>(t[1])],
+                          c = tm.vertices[static_cast<std::size_t>(t[2])];
+    Eigen::Vector3d n = (b - a).cross(c - a);
+    n = n.norm() > 0 ? n.normalized() : Eigen::Vector3d::UnitZ();
+    push(v, a, n); push(v, b, n); push(v, c, n);
+  }
+  return meshes_.emplace(&tm, upload(v)).first->second;
+}
+
+void Renderer::drawMesh(const Mesh& mesh, const Eigen::Matrix4d& model, const Colour& colour) {
+  const Eigen::Matrix4f mvp = (view_proj_ * model).cast<float>();
+  const Eigen::Matrix3d mv = view_.block<3, 3>(0, 0) * model.block<3, 3>(0, 0);
+  const Eigen::Matrix3f nm = mv.inverse().transpose().cast<float>();
+  glUniformMatrix4fv(u_mvp_, 1, GL_FALSE, mvp.data());  // Eigen is column-major, as GL expects
+  glUniformMatrix3fv(u_normal_, 1, GL_FALSE, nm.data());
+  glUniform4f(u_colour_, colour[0], colour[1], colour[2], colour[3]);
+  glBindVertexArray(mesh.vao);
+  glDrawArrays(GL_TRIANGLES, 0, mesh.count);
+}
+
+void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, int height,
+                    const std::array<float, 3>& background) {
+  glViewport(0, 0, width, height);
+  glClearColor(background[0], background[1], background[2], 1.0f);
+  glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glEnable(GL_DEPTH_TEST);
+  glDepthFunc(GL_LESS);
+  glDisable(GL_CULL_FACE);
+  glUseProgram(program_);
+  view_ = camera.view;
+  view_proj_ = camera.projection * camera.view;
+  const Eigen::Vector3f light = Eigen::Vector3f(0.3f, 0.5f, 1.0f).normalized();
+  glUniform3f(u_light_, light.x(), light.y(), light.z());
+  glUniform1i(u_unlit_, 0);
+  // planes first, pushed back in depth so that shapes lying on them win
+  glEnable(GL_POLYGON_OFFSET_FILL);
+  glPolygonOffset(1.0f, 1.0f);
+  for (const Primitive& p : scene.solids)
+    if (p.kind == Kind::kPlane) drawMesh(quad_, poseMatrix(p.pose, {p.length, p.length, 1.0}), p.colour);
+  glDisable(GL_POLYGON_OFFSET_FILL);
+  for (const Primitive& p : scene.solids) {
+    switch (p.kind) {
+      case Kind::kPlane: break;
+      case Kind::kSphere: drawMesh(sphere_, poseMatrix(p.pose, Eigen::Vector3d::Constant(p.radius)), p.colour); break;
+      case Kind::kCylinder: drawMesh(cylinder_, poseMatrix(p.pose, {p.radius, p.radius, p.length}), p.colour); break;
+      case Kind::kCone: drawMesh(cone_, poseMatrix(p.pose, {p.radius, p.radius, p.length}), p.colour); break;
+      case Kind::kBox: drawMesh(box_, poseMatrix(p.pose, p.size), p.colour); break;
+      case Kind::kCapsule: {
+        drawMesh(cylinder_, poseMatrix(p.pose, {p.radius, p.radius, p.length}), p.colour);
+        for (int s = -1; s <= 1; s += 2) {
+          SE3 end = p.pose;
+          end.p = p.pose.p + p.pose.R.col(2) * (0.5 * s * p.length);
+          drawMesh(sphere_, poseMatrix(end, Eigen::Vector3d::Constant(p.radius)), p.colour);
+        }
+        break;
+      }
+      case Kind::kMesh:
+        if (p.mesh) drawMesh(meshFor(*p.mesh), poseMatrix(p.pose, Eigen::Vector3d::Ones()), p.colour);
+        break;
+    }
+  }
+  // polylines, unlit, on top of the planes they lie on
+  glUniform1i(u_unlit_, 1);
+  const Eigen::Matrix4f vp = view_proj_.cast<float>();
+  glUniformMatrix4fv(u_mvp_, 1, GL_FALSE, vp.data());
+  const Eigen::Matrix3f id = Eigen::Matrix3f::Identity();
+  glUniformMatrix3fv(u_normal_, 1, GL_FALSE, id.data());
+  glBindVertexArray(line_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, line_vbo_);
+  for (const Polyline& l : scene.lines) {
+    if (l.points.size() < 2) continue;
+    std::vector<float> v;
+    for (const auto& q : l.points) push(v, q, Eigen::Vector3d::UnitZ());
+    glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(), GL_STREAM_DRAW);
+    glUniform4f(u_colour_, l.colour[0], l.colour[1], l.colour[2], l.colour[3]);
+    glDrawArrays(l.closed ? GL_LINE_LOOP : GL_LINE_STRIP, 0, static_cast<GLsizei>(l.points.size()));
+  }
+  glBindVertexArray(0);
+  glUseProgram(0);
+}
+
+}  // namespace mannequin::render

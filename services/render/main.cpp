@@ -1,0 +1,340 @@
+// mannequin-render: one render node, one view (docs/render.md). A thin main over mannequin::render.
+//   --headless: an off-screen EGL context, PNG frames into --out (deterministic: the same input gives the
+//               same files); --from F.mcap renders the sim.world messages of a recording frame by frame.
+//   otherwise:  a GLFW window (needs a display); --from plays the recording at its own pace, looping.
+//   --connect:  the live sim.world of publishers (newest state; headless: a frame per new state).
+//               A wall view with `head_body` takes its eye from that rigid body of mocap.frame (same endpoints).
+// Not yet (issue 14, later steps): the service kit (heartbeats, launcher), the swap barrier.
+#include <GLFW/glfw3.h>
+
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <optional>
+#include <set>
+#include <thread>
+
+#include <spdlog/spdlog.h>
+
+#include "mannequin/core/config.hpp"
+#include "mannequin/core/main.hpp"
+#include "mannequin/core/paths.hpp"
+#include "mannequin/recording/mcap_reader.hpp"
+#include "mannequin/render/renderer.hpp"
+#include "mannequin/render/view.hpp"
+#include "mannequin/simservice/config.hpp"
+#include "mannequin/transport/subscriber.hpp"
+#include "mannequin/transport/topics.hpp"
+#include "mannequin/skeleton/anthropometry.hpp"
+#include "mannequin/v1/world.pb.h"
+
+using namespace mannequin;
+namespace fs = std::filesystem;
+
+namespace {
+
+constexpr const char* kWorldTopic = "sim.world";
+
+struct Options {
+  std::string view = "configs/views/desktop.yaml";
+  std::string sim, scene, from, out, size;
+  std::vector<std::string> connect;  // live sim.world publishers
+  double duration = 0;               // live: s of wall time (0: until SIGINT/SIGTERM or --frames)
+  bool headless = false;
+  int every = 1;
+  long long frames = 0;  // 0: all
+};
+
+/// Geometry: the sim config's scene and mannequins, or --scene; models not named there are looked up as
+/// configs/mannequins/<model>.yaml (the model name is the config's `name`).
+render::SceneAssets loadAssets(const Options& o) {
+  render::SceneAssets a;
+  if (!o.sim.empty()) {
+    const simservice::SimServiceConfig cfg = simservice::loadSimConfig(core::findData(o.sim));
+    if (cfg.world.physics.enabled) a.scene = cfg.world.physics.scene;
+    for (const auto& m : cfg.mannequins) a.addModel(m.name, skeleton::buildMannequin(skeleton::loadMannequinSpec(m.config)));
+  }
+  if (!o.scene.empty()) a.scene = collision::loadScene(core::findData(o.scene));
+  return a;
+}
+
+void addMissingModels(const v1::WorldState& ws, render::SceneAssets& assets, std::set<std::string>& tried) {
+  for (const v1::MannequinState& m : ws.mannequins()) {
+    if (assets.capsules.count(m.name()) || assets.capsules.count(m.model()) || !tried.insert(m.model()).second) continue;
+    try {
+      const std::string path = core::findData("configs/mannequins/" + m.model() + ".yaml");
+      assets.addModel(m.model(), skeleton::buildMannequin(skeleton::loadMannequinSpec(path)));
+      spdlog::info("mannequin '{}': model '{}' from {}", m.name(), m.model(), path);
+    } catch (const std::exception& e) {
+      spdlog::warn("mannequin '{}': no model '{}' ({}); drawn as spheres (pass --sim)", m.name(), m.model(), e.what());
+    }
+  }
+}
+
+/// Every sim.world message of a recording, in log-time order.
+std::vector<v1::WorldState> readRecording(const std::string& path) {
+  const recording::McapReader reader = recording::McapReader::open(path);
+  recording::ReadFilter filter;
+  filter.topics = {kWorldTopic};
+  (void)reader.channelsOf(filter.topics);  // throws listing the file's topics when it has no sim.world
+  std::vector<v1::WorldState> out;
+  recording::MessageCursor cursor = reader.messages(filter);
+  recording::Message msg;
+  while (cursor.next(msg)) {
+    v1::WorldState ws;
+    if (!ws.ParseFromString(msg.data))
+      throw std::runtime_error(path + ": sim.world message " + std::to_string(out.size()) + " is not a WorldState");
+    out.push_back(std::move(ws));
+  }
+  return out;
+}
+
+/// The newest sim.world of the publishers in `o.connect` (kLatest: a backlog is skipped; the publisher
+/// re-sends its last state to a late subscriber, so a node shows the current scene at once).
+class LiveWorld {
+ public:
+  LiveWorld(const std::vector<std::string>& endpoints, const render::ViewConfig& view)
+      : sub_(context_, transport::SubscriberOptions{"render", endpoints}) {
+    sub_.subscribe(transport::topics::kSimWorld, [this](const v1::WorldState& ws) {
+      latest_ = ws;
+      ++received_;
+    });
+    if (!view.head_body.empty())  // a wall with a tracked head: its eye follows that rigid body of mocap.frame
+      sub_.subscribe(transport::topics::kMocapFrame, [this, &view](const v1::MocapFrame& f) {
+        if (const auto h = render::trackedHead(f, view)) head_ = h;
+      });
+  }
+  /// The camera of `view` with the tracked head when there is one; a head that left the room (behind the
+  /// wall) keeps the last usable camera.
+  const render::Camera& camera(const render::ViewConfig& view, int w, int h) {
+    render::ViewConfig v = view;
+    if (head_) v.head = *head_;
+    try {
+      camera_ = v.camera(w, h);
+    } catch (const std::invalid_argument& e) {
+      if (!camera_) camera_ = view.camera(w, h);
+    }
+    return *camera_;
+  }
+  /// Waits up to `timeout` for traffic; true when a newer state than the last call's arrived.
+  bool poll(std::chrono::microseconds timeout) {
+    sub_.poll(timeout);
+    const bool fresh = received_ != seen_;
+    seen_ = received_;
+    return fresh;
+  }
+  const v1::WorldState& latest() const { return latest_; }
+  long long received() const { return received_; }
+
+ private:
+  zmq::context_t context_;
+  transport::Subscriber sub_;
+  v1::WorldState latest_;
+  long long received_ = 0, seen_ = 0;
+  std::optional<render::Vec3> head_;
+  std::optional<render::Camera> camera_;
+};
+
+int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets) {
+  int w = view.width, h = view.height;
+  if (!o.size.empty()) {
+    const auto s = render::parseSize(o.size);
+    w = s[0];
+    h = s[1];
+  }
+  if (o.out.empty()) {
+    spdlog::error("--headless needs --out DIR (where the PNG frames go)");
+    return core::kExitUsage;
+  }
+  fs::create_directories(o.out);
+  render::HeadlessContext ctx(w, h);
+  render::Renderer renderer;
+  spdlog::info("headless {}x{} on {}", w, h, render::Renderer::describeContext());
+  const render::Camera cam = view.camera(w, h);
+  std::set<std::string> tried;
+  long long written = 0;
+  const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index) {
+    renderer.draw(scene, camera, w, h, view.background);
+    char name[64];
+    std::snprintf(name, sizeof name, "frame_%06zu.png", index);
+    render::writePng((fs::path(o.out) / name).string(), ctx.read());
+    ++written;
+  };
+  if (!o.connect.empty()) {
+    // live: a frame per new state (every Nth), named by its arrival count, until --frames, --duration or a signal
+    LiveWorld live(o.connect, view);
+    const auto& stop = core::installStopSignals();
+    const auto start = std::chrono::steady_clock::now();
+    long long states = 0;
+    while (!stop.load() && (o.frames <= 0 || written < o.frames) &&
+           (o.duration <= 0 || std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < o.duration)) {
+      if (!live.poll(std::chrono::milliseconds(100))) continue;
+      const long long index = states++;
+      if (index % o.every != 0) continue;
+      addMissingModels(live.latest(), assets, tried);
+      emit(render::buildScene(live.latest(), assets, view.style), live.camera(view, w, h), static_cast<std::size_t>(index));
+    }
+  } else if (o.from.empty()) {
+    // neither a recording nor publishers: the static scene, once
+    emit(render::buildStaticScene(assets, view.style), cam, 0);
+  } else {
+    const std::vector<v1::WorldState> states = readRecording(o.from);
+    if (states.empty()) {
+      spdlog::error("{}: no sim.world messages", o.from);
+      return core::kExitFailure;
+    }
+    for (std::size_t i = 0; i < states.size(); i += static_cast<std::size_t>(o.every)) {
+      if (o.frames > 0 && written >= o.frames) break;
+      addMissingModels(states[i], assets, tried);
+      emit(render::buildScene(states[i], assets, view.style), cam, i);
+    }
+  }
+  std::printf("wrote %lld frames (%dx%d) to %s\n", written, w, h, o.out.c_str());
+  return core::kExitOk;
+}
+
+struct Mouse {
+  render::OrbitCamera* orbit = nullptr;
+  double x = 0, y = 0;
+  bool left = false, right = false;
+};
+
+int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets) {
+  const char* x11 = std::getenv("DISPLAY");
+  const char* wl = std::getenv("WAYLAND_DISPLAY");
+  if ((x11 == nullptr || *x11 == '\0') && (wl == nullptr || *wl == '\0')) {
+    spdlog::error("no display (DISPLAY and WAYLAND_DISPLAY are not set): use --headless --out DIR to render PNG "
+                  "frames off-screen");
+    return core::kExitUsage;
+  }
+  if (glfwInit() != GLFW_TRUE) {
+    spdlog::error("cannot open the display '{}' (glfwInit failed): use --headless --out DIR to render PNG frames "
+                  "off-screen", x11 ? x11 : wl);
+    return core::kExitUsage;
+  }
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 3);
+  glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 3);
+  glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+  glfwWindowHint(GLFW_OPENGL_FORWARD_COMPAT, GLFW_TRUE);
+  GLFWwindow* win = glfwCreateWindow(view.width, view.height, ("mannequin-render: " + view.name).c_str(), nullptr, nullptr);
+  if (win == nullptr) {
+    glfwTerminate();
+    spdlog::error("cannot create an OpenGL 3.3 core window: use --headless --out DIR");
+    return core::kExitUsage;
+  }
+  glfwMakeContextCurrent(win);
+  glfwSwapInterval(1);
+  std::vector<v1::WorldState> states;
+  if (!o.from.empty()) states = readRecording(o.from);
+  std::unique_ptr<LiveWorld> live;
+  if (!o.connect.empty()) live = std::make_unique<LiveWorld>(o.connect, view);
+  std::set<std::string> tried;
+  int rc = core::kExitOk;
+  {
+    render::Renderer renderer;
+    spdlog::info("window {}x{} on {}", view.width, view.height, render::Renderer::describeContext());
+    render::OrbitCamera orbit = view.orbit;
+    Mouse mouse{&orbit};
+    glfwSetWindowUserPointer(win, &mouse);
+    if (view.type == render::ViewConfig::Type::kDesktop) {
+      glfwSetMouseButtonCallback(win, [](GLFWwindow* w, int button, int action, int) {
+        auto* m = static_cast<Mouse*>(glfwGetWindowUserPointer(w));
+        if (button == GLFW_MOUSE_BUTTON_LEFT) m->left = action == GLFW_PRESS;
+        if (button == GLFW_MOUSE_BUTTON_RIGHT) m->right = action == GLFW_PRESS;
+      });
+      glfwSetCursorPosCallback(win, [](GLFWwindow* w, double x, double y) {
+        auto* m = static_cast<Mouse*>(glfwGetWindowUserPointer(w));
+        if (m->left) m->orbit->rotate(-0.01 * (x - m->x), 0.01 * (y - m->y));
+        if (m->right) m->orbit->pan(-0.002 * m->orbit->distance * (x - m->x), 0.002 * m->orbit->distance * (y - m->y));
+        m->x = x;
+        m->y = y;
+      });
+      glfwSetScrollCallback(win, [](GLFWwindow* w, double, double dy) {
+        static_cast<Mouse*>(glfwGetWindowUserPointer(w))->orbit->zoom(std::pow(0.9, dy));
+      });
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const auto& stop = core::installStopSignals();
+    const render::RenderScene still = render::buildStaticScene(assets, view.style);
+    long long swapped = 0;
+    while (!glfwWindowShouldClose(win) && !stop.load()) {
+      int w = 0, h = 0;
+      glfwGetFramebufferSize(win, &w, &h);
+      render::ViewConfig v = view;
+      v.orbit = orbit;
+      if (live) live->poll(std::chrono::microseconds(0));
+      const render::Camera cam = live ? live->camera(v, w, h) : v.camera(w, h);
+      if (live) {
+        if (live->received() == 0) {
+          renderer.draw(still, cam, w, h, view.background);
+        } else {
+          addMissingModels(live->latest(), assets, tried);
+          renderer.draw(render::buildScene(live->latest(), assets, view.style), cam, w, h, view.background);
+        }
+      } else if (states.empty()) {
+        renderer.draw(still, cam, w, h, view.background);
+      } else {  // play at the recording's sim time, looping
+        const double span = std::max(1e-9, states.back().sim_time() - states.front().sim_time());
+        const double t = std::fmod(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), span) +
+                         states.front().sim_time();
+        std::size_t i = 0;
+        while (i + 1 < states.size() && states[i + 1].sim_time() <= t) ++i;
+        addMissingModels(states[i], assets, tried);
+        renderer.draw(render::buildScene(states[i], assets, view.style), cam, w, h, view.background);
+      }
+      glfwSwapBuffers(win);
+      glfwPollEvents();
+      if (o.frames > 0 && ++swapped >= o.frames) break;
+    }
+  }
+  glfwDestroyWindow(win);
+  glfwTerminate();
+  return rc;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"mannequin-render: one render node: draws the mannequins, the scene, objects, contacts and force\n"
+               "arrows of sim.world for one view (desktop orbit camera or a VR wall's off-axis frustum).\n"
+               "--headless renders off-screen (EGL, no display needed) into PNG frames; --from renders a\n"
+               "recording (MCAP with sim.world, e.g. from mannequin-simulate --out or mannequin-record)."};
+  Options o;
+  std::string log_level = "info";
+  app.add_option("--view", o.view, "view file (configs/views/*.yaml)")->capture_default_str();
+  app.add_option("--sim", o.sim, "sim config whose scene and mannequin models to draw (configs/sim/*.yaml)");
+  app.add_option("--scene", o.scene, "scene file (configs/scenes/*.yaml); overrides the sim config's");
+  auto* connect = app.add_option("--connect", o.connect,
+                                 "render the live sim.world of this publisher (e.g. tcp://127.0.0.1:5556; repeatable)");
+  app.add_option("--duration", o.duration, "live: stop after S seconds (0: at --frames or SIGINT/SIGTERM)")
+      ->check(CLI::NonNegativeNumber);
+  app.add_option("--from", o.from, "render the sim.world messages of this MCAP recording")->excludes(connect);
+  app.add_flag("--headless", o.headless, "render off-screen into PNG frames (needs --out)");
+  app.add_option("--size", o.size, "headless image size WIDTHxHEIGHT (default: the view's size)")
+      ->check([](const std::string& s) {
+        try {
+          (void)render::parseSize(s);
+          return std::string();
+        } catch (const std::exception& e) {
+          return std::string(e.what());
+        }
+      });
+  app.add_option("--out", o.out, "directory of the PNG frames (frame_NNNNNN.png, N = message index)");
+  app.add_option("--every", o.every, "render every Nth message")->check(CLI::PositiveNumber)->capture_default_str();
+  app.add_option("--frames", o.frames, "write at most K frames (0: all); a window closes after K frames")->check(CLI::NonNegativeNumber);
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical, off")->check(core::logLevelCheck());
+  return core::runMain(app, argc, argv, [&] {
+    core::setupLogging(log_level);
+    render::ViewConfig view;
+    render::SceneAssets assets;
+    try {
+      view = render::loadView(core::findData(o.view));
+      assets = loadAssets(o);
+    } catch (const core::ConfigError& e) {
+      spdlog::error("{}", e.what());
+      return core::kExitUsage;
+    }
+    return o.headless ? runHeadless(o, view, assets) : runWindow(o, view, assets);
+  });
+}

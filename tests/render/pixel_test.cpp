@@ -1,0 +1,204 @@
+// Pixel tests on headless frames (EGL surfaceless, Mesa llvmpipe when there is no GPU).
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <memory>
+
+#include "fixtures.hpp"
+#include "mannequin/render/renderer.hpp"
+#include "mannequin/math/frame.hpp"
+#include "mannequin/render/view.hpp"
+
+namespace mannequin::render {
+namespace {
+
+// Colour classes of the default Style under the renderer's shading (factor 0.35 to 1 of the base colour).
+bool isMannequinBlue(const std::array<std::uint8_t, 3>& c) {
+  return c[2] > 60 && c[2] > 1.6 * c[0] && c[2] > 1.3 * c[1];
+}
+bool isForce(const std::array<std::uint8_t, 3>& c) { return c[0] > 80 && c[0] >= c[1] && 3 * c[2] < c[0]; }
+
+struct Box {
+  double x0 = 1e18, y0 = 1e18, x1 = -1e18, y1 = -1e18;
+  void add(const Eigen::Vector2d& p) {
+    x0 = std::min(x0, p.x()); y0 = std::min(y0, p.y());
+    x1 = std::max(x1, p.x()); y1 = std::max(y1, p.y());
+  }
+  bool contains(double x, double y, double margin) const {
+    return x >= x0 - margin && x <= x1 + margin && y >= y0 - margin && y <= y1 + margin;
+  }
+};
+
+// The pixel box of a sphere-swept set of points (each point ± r along the world axes).
+void addSwept(Box& box, const Camera& cam, const Vec3& p, double r, int w, int h) {
+  for (int a = 0; a < 3; ++a)
+    for (int s = -1; s <= 1; s += 2) box.add(cam.pixel(p + s * r * Vec3::Unit(a), w, h));
+}
+
+class Headless : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    try {
+      ctx_ = std::make_unique<HeadlessContext>(kW, kH);
+      renderer_ = std::make_unique<Renderer>();
+    } catch (const RenderError& e) {
+      GTEST_SKIP() << "no headless OpenGL 3.3 here (" << e.what() << "); tools/setup installs Mesa's EGL";
+    }
+  }
+  void TearDown() override {
+    if (ctx_) ctx_->makeCurrent();
+    renderer_.reset();
+    ctx_.reset();
+  }
+  Image render(const RenderScene& s, const Camera& cam) {
+    ctx_->makeCurrent();
+    renderer_->draw(s, cam, kW, kH, {0.11f, 0.12f, 0.14f});
+    return ctx_->read();
+  }
+  static constexpr int kW = 320, kH = 240;
+  std::unique_ptr<HeadlessContext> ctx_;
+  std::unique_ptr<Renderer> renderer_;
+};
+
+class Scenes : public Headless {
+ protected:
+  void SetUp() override {
+    Headless::SetUp();
+    if (IsSkipped()) return;
+    model_ = std::make_unique<skeleton::Model>(testing::male50());
+    assets_.scene = collision::loadScene(testing::sourcePath("configs/scenes/floor.yaml"));
+    assets_.addModel(model_->name, *model_);
+    ms_ = testing::addMannequin(ws_, *model_, skeleton::standingConfiguration(*model_), "alice");
+    orbit_.target = Vec3(0, 0, 0.9);
+    orbit_.distance = 3.2;
+    orbit_.yaw = 0.0;      // the eye on +x, looking along −x: world +y is image right
+    orbit_.pitch = 0.1;
+    cam_ = orbit_.camera(static_cast<double>(kW) / kH);
+  }
+  std::unique_ptr<skeleton::Model> model_;
+  SceneAssets assets_;
+  v1::WorldState ws_;
+  v1::MannequinState* ms_ = nullptr;
+  OrbitCamera orbit_;
+  Camera cam_;
+};
+
+TEST_F(Headless, ContextIsOpenGL33CoreAndReportsItsRenderer) {
+  const std::string d = Renderer::describeContext();
+  EXPECT_NE(d.find('|'), std::string::npos);
+  std::printf("headless context: %s\n", d.c_str());
+}
+
+TEST_F(Scenes, MannequinColourOccupiesTheProjectedRegionOfItsCapsules) {
+  const RenderScene scene = buildScene(ws_, assets_);
+  const Image img = render(scene, cam_);
+  Box expected;
+  for (const Primitive& p : scene.solids) {
+    if (p.layer != Layer::kMannequin) continue;
+    const Vec3 half = p.kind == Kind::kCapsule ? Vec3(0.5 * p.length * p.pose.R.col(2)) : Vec3::Zero();
+    addSwept(expected, cam_, p.pose.p - half, p.radius, kW, kH);
+    addSwept(expected, cam_, p.pose.p + half, p.radius, kW, kH);
+  }
+  Box seen;
+  int blue = 0, outside = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (isMannequinBlue(img.at(x, y))) {
+        ++blue;
+        seen.add({x + 0.5, y + 0.5});
+        if (!expected.contains(x + 0.5, y + 0.5, 1.5)) ++outside;
+      }
+  EXPECT_EQ(outside, 0);
+  // the figure spans (almost) its whole projected height: head to feet are drawn
+  EXPECT_GT(seen.y1 - seen.y0, 0.9 * (expected.y1 - expected.y0));
+  EXPECT_GT(blue, 1500);  // ≈ a 1.75 m figure at ~290 px/m: thousands of pixels
+  // and nothing blue outside the figure when the mannequin is removed
+  v1::WorldState empty;
+  const Image none = render(buildScene(empty, assets_), cam_);
+  int blue_none = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) blue_none += isMannequinBlue(none.at(x, y)) ? 1 : 0;
+  EXPECT_EQ(blue_none, 0);
+}
+
+TEST_F(Scenes, AContactForceDrawsAnArrowOfTheForceColourWhereItPointsAndNotWithoutIt) {
+  const Vec3 point(0.0, 0.45, 1.2);   // beside the figure, image right
+  const Vec3 force(0.0, 250.0, 0.0);  // 250 N along +y: the arrow points further right, 0.5 m long
+  const Image before = render(buildScene(ws_, assets_), cam_);
+  int force_before = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) force_before += isForce(before.at(x, y)) ? 1 : 0;
+  EXPECT_EQ(force_before, 0);
+
+  testing::addContact(*ms_, point, Vec3::UnitY(), force, "alice/hand_r", "wall");
+  const Style style;
+  const RenderScene scene = buildScene(ws_, assets_, style);
+  const Image after = render(scene, cam_);
+  Box arrow;
+  const double len = style.force_scale * force.norm();
+  addSwept(arrow, cam_, point, 2.2 * style.arrow_radius, kW, kH);
+  addSwept(arrow, cam_, point + force.normalized() * len, 2.2 * style.arrow_radius, kW, kH);
+  int inside = 0, outside = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (isForce(after.at(x, y))) (arrow.contains(x + 0.5, y + 0.5, 1.5) ? inside : outside)++;
+  EXPECT_EQ(outside, 0);
+  EXPECT_GT(inside, 0.4 * (arrow.x1 - arrow.x0) * 3);  // a shaft ≥ 3 px thick along most of its length
+  // the arrow's far end is to the right of its start (+y is image right from this camera)
+  EXPECT_GT(cam_.pixel(point + force.normalized() * len, kW, kH).x(), cam_.pixel(point, kW, kH).x() + 30);
+}
+
+TEST_F(Scenes, TwoWallViewsOfOneFrameAgreeAtTheirSharedEdge) {
+  const ViewConfig front = loadView(testing::sourcePath("configs/views/wall_front.yaml"));
+  const ViewConfig right = loadView(testing::sourcePath("configs/views/wall_right.yaml"));
+  const Vec3 head(0.3, -0.2, 1.6);
+  const Vec3 edge(1.5, -1.5, 1.3);  // on the shared vertical edge
+  const Vec3 p0 = head + 2.0 * (edge - head);
+  const Vec3 d = ((edge - head).cross(Vec3::UnitZ()).normalized() + Vec3(0, 0, 0.3)).normalized();
+  RenderScene scene;
+  Primitive bar;
+  bar.kind = Kind::kCapsule;
+  bar.layer = Layer::kMannequin;
+  bar.radius = 0.06;
+  bar.length = 1.4;
+  bar.pose = SE3(math::frameAlong(d), p0);
+  bar.colour = Style{}.mannequin_colours[0];
+  scene.solids.push_back(bar);
+  const Image fi = render(scene, wallCamera(front.wall, head, 0.05, 100));
+  const Image ri = render(scene, wallCamera(right.wall, head, 0.05, 100));
+  const auto meanRow = [](const Image& img, int x) {
+    double sum = 0;
+    int n = 0;
+    for (int y = 0; y < img.height; ++y)
+      if (isMannequinBlue(img.at(x, y))) { sum += y; ++n; }
+    return std::make_pair(n, n ? sum / n : -1.0);
+  };
+  const auto [nf, yf] = meanRow(fi, kW - 1);  // front's right border column
+  const auto [nr, yr] = meanRow(ri, 0);       // right wall's left border column
+  ASSERT_GT(nf, 3);
+  ASSERT_GT(nr, 3);
+  EXPECT_LE(std::abs(yf - yr), 2.0) << "front row " << yf << ", right row " << yr;
+  EXPECT_LE(std::abs(nf - nr), 2) << "bar thickness at the edge";
+}
+
+TEST_F(Scenes, RenderingIsDeterministicAndWritesAPng) {
+  testing::addContact(*ms_, Vec3(0.1, 0.1, 0.0), Vec3::UnitZ(), Vec3(0, 0, 300), "alice/foot_l", "floor");
+  const RenderScene scene = buildScene(ws_, assets_);
+  const Image a = render(scene, cam_);
+  const Image b = render(scene, cam_);
+  EXPECT_EQ(a.rgb, b.rgb);
+  const std::string path = (std::filesystem::temp_directory_path() / "mannequin_render_test.png").string();
+  writePng(path, a);
+  std::ifstream in(path, std::ios::binary);
+  char sig[8] = {};
+  in.read(sig, 8);
+  EXPECT_EQ(std::string(sig + 1, 3), "PNG");
+  EXPECT_GT(std::filesystem::file_size(path), 1000u);
+  std::filesystem::remove(path);
+  EXPECT_THROW(writePng("/nonexistent/dir/x.png", a), RenderError);
+}
+
+}  // namespace
+}  // namespace mannequin::render

@@ -1,0 +1,251 @@
+// mannequin-render as a process: --help, bad input (exit 2 with FILE and key), no display without --headless
+// (exit 2 with the --headless hint), and a recording rendered headless frame by frame, deterministically.
+#include <gtest/gtest.h>
+
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <array>
+#include <atomic>
+#include <thread>
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "fixtures.hpp"
+#include "mannequin/proto/schema.hpp"
+#include "mannequin/recording/mcap_writer.hpp"
+#include "mannequin/transport/publisher.hpp"
+#include "mannequin/transport/topics.hpp"
+
+namespace fs = std::filesystem;
+
+namespace mannequin::render {
+namespace {
+
+// the tool lands in build/bin, the test binary in build/bin/tests
+fs::path toolPath() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "mannequin-render"; }
+
+fs::path temp(const std::string& name) {
+  return fs::temp_directory_path() / ("render_tool_test_" + std::to_string(::getpid()) + "_" + name);
+}
+
+struct ToolRun {
+  int status = -1;
+  std::string out, err;
+};
+
+// Runs the tool under timeout(1) (a hung run fails at the deadline); `env` prefixes the command.
+ToolRun run(const std::string& args, const std::string& env = "", int timeout_s = 120) {
+  ToolRun r;
+  const fs::path err = temp("stderr");
+  const std::string cmd = env + " timeout " + std::to_string(timeout_s) + " " + toolPath().string() + " " + args +
+                          " 2>" + err.string();
+  FILE* p = ::popen(cmd.c_str(), "r");
+  if (p == nullptr) return r;
+  std::array<char, 4096> buf{};
+  std::size_t n;
+  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
+  const int st = ::pclose(p);
+  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
+  std::ifstream in(err);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  r.err = ss.str();
+  fs::remove(err);
+  return r;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream in(p, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  return ss.str();
+}
+
+// Five sim.world messages of a standing male_50th, the last two with a 200 N contact force.
+fs::path writeRecording() {
+  const fs::path path = temp("run.mcap");
+  const skeleton::Model model = testing::male50();
+  recording::McapWriter w(path.string());
+  const auto schema = w.addSchema("mannequin.v1.WorldState", "protobuf", proto::fileDescriptorSet(v1::WorldState::descriptor()));
+  const auto ch = w.addChannel("sim.world", schema, "protobuf");
+  for (int i = 0; i < 5; ++i) {
+    v1::WorldState ws;
+    ws.set_step(static_cast<std::uint64_t>(10 * i));
+    ws.set_sim_time(0.1 * i);
+    math::VectorX q = skeleton::standingConfiguration(model);
+    q(0) += 0.05 * i;  // walks along x
+    v1::MannequinState* ms = testing::addMannequin(ws, model, q, "alice");
+    if (i >= 3) testing::addContact(*ms, math::Vector3(0.3, 0.4, 1.0), math::Vector3::UnitY(), math::Vector3(0, 200, 0), "alice/hand_l", "wall");
+    std::string payload;
+    ws.SerializeToString(&payload);
+    const auto t = static_cast<recording::Timestamp>(100'000'000LL * i);
+    w.write(ch, static_cast<std::uint32_t>(i + 1), t, t, payload);
+  }
+  w.close();
+  return path;
+}
+
+TEST(RenderTool, HelpListsTheOptions) {
+  const ToolRun r = run("--help");
+  EXPECT_EQ(r.status, 0) << r.err;
+  for (const char* opt : {"--view", "--headless", "--size", "--out", "--every", "--frames", "--from", "--sim"})
+    EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
+}
+
+TEST(RenderTool, MissingOrInvalidViewFileExitsTwoNamingFileAndKey) {
+  const ToolRun missing = run("--view /nonexistent/v.yaml --headless --out " + temp("o").string());
+  EXPECT_EQ(missing.status, 2) << missing.err;
+  EXPECT_NE(missing.err.find("/nonexistent/v.yaml"), std::string::npos) << missing.err;
+
+  const fs::path bad = temp("bad_view.yaml");
+  std::ofstream(bad) << "name: x\ntype: desktop\ncamera: {distance: 3, zoom: 2}\n";
+  const ToolRun invalid = run("--view " + bad.string() + " --headless --out " + temp("o").string());
+  EXPECT_EQ(invalid.status, 2) << invalid.err;
+  EXPECT_NE(invalid.err.find(bad.string() + ":3"), std::string::npos) << invalid.err;
+  EXPECT_NE(invalid.err.find("zoom"), std::string::npos) << invalid.err;
+  fs::remove(bad);
+}
+
+TEST(RenderTool, NoDisplayWithoutHeadlessExitsTwoWithTheHint) {
+  const ToolRun r = run("--view configs/views/desktop.yaml", "env -u DISPLAY -u WAYLAND_DISPLAY");
+  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_NE(r.err.find("no display"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("--headless"), std::string::npos) << r.err;
+}
+
+TEST(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
+  const fs::path mcap = writeRecording();
+  const fs::path a = temp("a"), b = temp("b"), c = temp("c");
+  const std::string common = "--view configs/views/desktop.yaml --scene configs/scenes/floor.yaml --headless --size 160x120 --from " +
+                             mcap.string();
+  const ToolRun ra = run(common + " --every 2 --out " + a.string());
+  ASSERT_EQ(ra.status, 0) << ra.err;
+  // every 2nd message: 0, 2, 4, named by message index
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(a)) names.push_back(e.path().filename().string());
+  std::sort(names.begin(), names.end());
+  EXPECT_EQ(names, (std::vector<std::string>{"frame_000000.png", "frame_000002.png", "frame_000004.png"}));
+  const ToolRun rb = run(common + " --every 2 --out " + b.string());
+  ASSERT_EQ(rb.status, 0) << rb.err;
+  for (const auto& n : names) EXPECT_EQ(slurp(a / n), slurp(b / n)) << n << " differs between two runs";
+  // the mannequin moves: consecutive frames differ
+  EXPECT_NE(slurp(a / names[0]), slurp(a / names[1]));
+  // --frames caps the count
+  const ToolRun rc = run(common + " --frames 2 --out " + c.string());
+  ASSERT_EQ(rc.status, 0) << rc.err;
+  EXPECT_EQ(std::distance(fs::directory_iterator(c), fs::directory_iterator{}), 2);
+  EXPECT_NE(rc.out.find("wrote 2 frames (160x120)"), std::string::npos) << rc.out;
+  for (const fs::path& d : {a, b, c}) fs::remove_all(d);
+  fs::remove(mcap);
+}
+
+TEST(RenderTool, RendersTheLiveSimWorldOfAPublisher) {
+  zmq::context_t ctx;
+  transport::Publisher pub(ctx, {"sim", {"tcp://127.0.0.1:0"}});
+  const std::string endpoint = pub.boundEndpoints().at(0);
+  std::atomic<bool> done{false};
+  std::thread publisher([&] {  // a state every 20 ms until the node has its frames (deadline: run()'s timeout)
+    const skeleton::Model model = testing::male50();
+    for (std::uint64_t i = 0; !done.load(); ++i) {
+      v1::WorldState ws;
+      ws.set_step(i);
+      math::VectorX q = skeleton::standingConfiguration(model);
+      q(1) += 0.01 * static_cast<double>(i % 50);
+      testing::addMannequin(ws, model, q, "alice");
+      pub.publish(transport::topics::kSimWorld, ws);
+      pub.poll();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  const fs::path out = temp("live");
+  const ToolRun r = run("--view configs/views/desktop.yaml --headless --size 160x120 --frames 3 --connect " + endpoint +
+                            " --out " + out.string(),
+                        "", 60);
+  done = true;
+  publisher.join();
+  ASSERT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote 3 frames"), std::string::npos) << r.out;
+  EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 3);
+  fs::remove_all(out);
+  // --from and --connect exclude each other: a usage error
+  const ToolRun both = run("--headless --out " + out.string() + " --from x.mcap --connect " + endpoint);
+  EXPECT_EQ(both.status, 2) << both.err;
+}
+
+TEST(RenderTool, AWallWithATrackedHeadDrawsWhatAFixedHeadThereDraws) {
+  // the same wall twice: a fixed head at E, and head_body "head" tracked at E by mocap.frame
+  const std::string wall =
+      "type: wall\nsize: [96, 96]\nwall: {lower_left: [1.5, 1.5, 0], lower_right: [1.5, -1.5, 0], upper_left: [1.5, 1.5, 3]}\n";
+  const fs::path fixed = temp("fixed.yaml"), tracked = temp("tracked.yaml");
+  std::ofstream(fixed) << wall << "head: [0.4, -0.3, 1.5]\n";
+  std::ofstream(tracked) << wall << "head: [0, 0, 1.7]\nhead_body: head\n";
+  zmq::context_t ctx;
+  transport::Publisher pub(ctx, {"sim", {"tcp://127.0.0.1:0"}});
+  const std::string endpoint = pub.boundEndpoints().at(0);
+  std::atomic<bool> done{false};
+  const skeleton::Model model = testing::male50();
+  v1::WorldState ws;
+  math::VectorX q = skeleton::standingConfiguration(model);
+  q(0) = 0.8;  // in front of the viewer, before the wall
+  testing::addMannequin(ws, model, q, "alice");
+  std::thread publisher([&] {
+    while (!done.load()) {
+      v1::MocapFrame f;
+      v1::RigidBody* b = f.add_bodies();
+      b->set_name("head");
+      b->set_tracked(true);
+      testing::toMsg(SE3(math::Matrix3::Identity(), Vector3(0.4, -0.3, 1.5)), *b->mutable_pose());
+      pub.publish(transport::topics::kMocapFrame, f);
+      v1::WorldState w = ws;
+      pub.publish(transport::topics::kSimWorld, w);
+      pub.poll();
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  const fs::path live = temp("tracked_out"), ref = temp("fixed_out");
+  const ToolRun r = run("--view " + tracked.string() + " --headless --frames 4 --connect " + endpoint + " --out " + live.string(), "", 60);
+  done = true;
+  publisher.join();
+  ASSERT_EQ(r.status, 0) << r.err;
+  const fs::path mcap = temp("one.mcap");
+  {
+    recording::McapWriter w(mcap.string());
+    const auto schema = w.addSchema("mannequin.v1.WorldState", "protobuf", proto::fileDescriptorSet(v1::WorldState::descriptor()));
+    const auto ch = w.addChannel("sim.world", schema, "protobuf");
+    w.write(ch, 1, 0, 0, ws.SerializeAsString());
+    w.close();
+  }
+  const ToolRun rr = run("--view " + fixed.string() + " --headless --from " + mcap.string() + " --out " + ref.string());
+  ASSERT_EQ(rr.status, 0) << rr.err;
+  std::vector<fs::path> frames;
+  for (const auto& e : fs::directory_iterator(live)) frames.push_back(e.path());
+  std::sort(frames.begin(), frames.end());
+  ASSERT_EQ(frames.size(), 4u);
+  // the last live frame (mocap arrived long before) is the fixed-head frame, byte for byte
+  EXPECT_EQ(slurp(frames.back()), slurp(ref / "frame_000000.png"));
+  for (const fs::path& p : {fixed, tracked, mcap}) fs::remove(p);
+  for (const fs::path& d : {live, ref}) fs::remove_all(d);
+}
+
+TEST(RenderTool, OpensAWindowUnderXvfb) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); the window path is not tested";
+  const ToolRun r = run("--view configs/views/desktop.yaml --scene configs/scenes/table.yaml --frames 3", "xvfb-run -a");
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.err.find("window 1280x720"), std::string::npos) << r.err;
+}
+
+TEST(RenderTool, BadSizeAndMissingOutAreUsageErrors) {
+  const ToolRun size = run("--headless --size 12x --out " + temp("o").string());
+  EXPECT_EQ(size.status, 2) << size.err;
+  EXPECT_NE((size.err + size.out).find("WIDTHxHEIGHT"), std::string::npos) << size.err;
+  const ToolRun out = run("--headless");
+  EXPECT_EQ(out.status, 2) << out.err;
+  EXPECT_NE(out.err.find("--out"), std::string::npos) << out.err;
+}
+
+}  // namespace
+}  // namespace mannequin::render
