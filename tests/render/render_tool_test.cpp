@@ -230,6 +230,68 @@ TEST(RenderTool, AWallWithATrackedHeadDrawsWhatAFixedHeadThereDraws) {
   for (const fs::path& d : {live, ref}) fs::remove_all(d);
 }
 
+// A publisher thread sending a standing mannequin with step i every 20 ms until stopped.
+class WorldPublisher {
+ public:
+  WorldPublisher() : pub_(ctx_, {"sim", {"tcp://127.0.0.1:0"}}), endpoint_(pub_.boundEndpoints().at(0)) {
+    thread_ = std::thread([this] {
+      const skeleton::Model model = testing::male50();
+      for (std::uint64_t i = 1; !done_.load(); ++i) {
+        v1::WorldState ws;
+        ws.set_step(i);
+        math::VectorX q = skeleton::standingConfiguration(model);
+        q(1) += 0.01 * static_cast<double>(i % 50);
+        testing::addMannequin(ws, model, q, "alice");
+        pub_.publish(transport::topics::kSimWorld, ws);
+        pub_.poll();
+        std::this_thread::sleep_for(std::chrono::milliseconds(20));
+      }
+    });
+  }
+  ~WorldPublisher() {
+    done_ = true;
+    thread_.join();
+  }
+  const std::string& endpoint() const { return endpoint_; }
+
+ private:
+  zmq::context_t ctx_;
+  transport::Publisher pub_;
+  std::string endpoint_;
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
+
+TEST(RenderTool, TheLauncherRunsARenderNodeLikeAnyService) {
+  WorldPublisher world;
+  const fs::path run_dir = temp("run"), out = temp("launched"), file = temp("deployment.yaml"), summary = temp("summary.json");
+  fs::create_directories(run_dir);
+  std::ofstream(file) << "name: render-test\nrun_dir: " << run_dir.string() << "\nservices:\n"
+                      << "  - name: wall\n    exec: " << toolPath().string() << "\n"
+                      << "    args: [--view, configs/views/desktop.yaml, --headless, --size, 96x96, --connect, " << world.endpoint()
+                      << ", --out, " << out.string() << "]\n"
+                      << "    publish: ipc://${RUN_DIR}/wall\n";
+  const fs::path launch = toolPath().parent_path() / "mannequin-launch";
+  const std::string cmd = "timeout 60 " + launch.string() + " " + file.string() + " --duration 3 --summary-json " +
+                          summary.string() + " >/dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(st)) << cmd;
+  EXPECT_EQ(WEXITSTATUS(st), 0) << cmd;
+  const std::string json = slurp(summary);
+  // the launcher saw the node's heartbeats (started with --name wall --publish ipc://RUN_DIR/wall)
+  const auto at = json.find("\"name\": \"wall\"");
+  ASSERT_NE(at, std::string::npos) << json;
+  const auto hb = json.find("\"heartbeats\": ", at);
+  ASSERT_NE(hb, std::string::npos) << json;
+  EXPECT_GT(std::stol(json.substr(hb + 14)), 0) << json;
+  const auto frames = json.find("\"frames\": ", at);
+  ASSERT_NE(frames, std::string::npos) << json;
+  EXPECT_GT(std::stod(json.substr(frames + 10)), 0.0) << json;
+  EXPECT_GT(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 0);
+  for (const fs::path& p : {file, summary}) fs::remove(p);
+  for (const fs::path& d : {run_dir, out}) fs::remove_all(d);
+}
+
 TEST(RenderTool, OpensAWindowUnderXvfb) {
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); the window path is not tested";
