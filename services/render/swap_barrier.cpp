@@ -2,6 +2,8 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
+
 #include "mannequin/transport/topics.hpp"
 
 namespace mannequin::render_node {
@@ -37,7 +39,7 @@ void SwapBarrier::post(std::uint64_t frame) {
 }
 
 void SwapBarrier::greet() {
-  const auto end = Clock::now() + timeout_;
+  const auto end = Clock::now() + std::max<std::chrono::nanoseconds>(timeout_, std::chrono::seconds(2));
   auto next = Clock::now();
   while (Clock::now() < end && !stopping_()) {
     if (Clock::now() >= next) {

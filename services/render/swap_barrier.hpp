@@ -30,8 +30,8 @@ class SwapBarrier {
 
   /// Handler of render.sync (own messages are ignored).
   void onMessage(const v1::RenderSync& m);
-  /// Start-up: posts a hello (frame 0) every 50 ms for `timeout` s so that nodes started together know
-  /// each other before their first frame.
+  /// Start-up: posts a hello (frame 0) every 50 ms for max(timeout, 2 s) so that nodes started together
+  /// know each other before their first frame.
   void greet();
   bool isLeader() const { return leader() == name_; }
   std::string leader() const;
