@@ -258,7 +258,10 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       std::uint64_t step = 0;
       if (barrier.isLeader()) {
         live.poll(std::chrono::milliseconds(5));
-        if (live.newestStep() <= last) continue;
+        if (live.newestStep() <= last) {
+          barrier.keepAlive(last);
+          continue;
+        }
         step = live.newestStep();
       } else {
         const auto f = barrier.awaitLeader(last, [&] { return live.newestStep() > last; });

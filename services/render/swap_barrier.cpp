@@ -22,6 +22,7 @@ void SwapBarrier::onMessage(const v1::RenderSync& m) {
   if (m.node() == name_) return;
   auto [it, fresh] = peers_.try_emplace(m.node());
   Peer& p = it->second;
+  p.heard = Clock::now();
   if (fresh) spdlog::info("swap barrier: peer '{}' joined", m.node());
   if (p.dropped && (m.frame() > p.frame || fresh)) {
     p.dropped = false;
@@ -36,6 +37,11 @@ void SwapBarrier::post(std::uint64_t frame) {
   m.set_node(name_);
   pub_.publish(transport::topics::kRenderSync, m);
   pub_.poll();
+  last_post_ = Clock::now();
+}
+
+void SwapBarrier::keepAlive(std::uint64_t frame) {
+  if (Clock::now() - last_post_ >= timeout_ / 4) post(frame);
 }
 
 void SwapBarrier::greet() {
@@ -72,13 +78,15 @@ std::optional<std::uint64_t> SwapBarrier::awaitLeader(std::uint64_t after, const
     const Peer& p = peers_.at(l);
     if (p.frame > after) return p.frame;
     if (!deadline && have_newer()) deadline = Clock::now() + timeout_;
-    if (deadline && Clock::now() >= *deadline) {
+    // dead: a newer state waits here for the timeout and nothing at all came from the leader meanwhile
+    if (deadline && Clock::now() >= *deadline && Clock::now() - p.heard >= timeout_) {
       peers_.at(l).dropped = true;
       ++drops_;
       spdlog::warn("swap barrier: leader '{}' silent for {} ms; dropped", l,
                    std::chrono::duration_cast<std::chrono::milliseconds>(timeout_).count());
       return std::nullopt;
     }
+    keepAlive(after);
     poll_(std::chrono::milliseconds(2));
   }
   return std::nullopt;

@@ -8,8 +8,8 @@
 /// state and posts its step f; a follower waits for the leader's post of a step newer than its last
 /// one, draws that step and posts it; then every node waits until every peer not dropped has posted a
 /// step >= f, and swaps. A peer that does not answer within the timeout is dropped (not waited for)
-/// until it posts again; a leader that does not post within the timeout while this node has a newer
-/// state is dropped too (the next name leads). A node that joins late is waited for from its first post.
+/// until it posts again; a leader that posts nothing at all (not even its keep-alive, see keepAlive())
+/// for the timeout while this node has a newer state is dropped too (the next name leads). A node that joins late is waited for from its first post.
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -42,12 +42,16 @@ class SwapBarrier {
   /// late ones are dropped). Returns the number of peers that made it.
   int arriveAndWait(std::uint64_t frame);
   int peers() const;  ///< peers not dropped
+  /// While waiting (for a leader or a new state): re-posts `frame` (the last one swapped) at most every
+  /// timeout/4, so peers see this node alive and do not take it for dead.
+  void keepAlive(std::uint64_t frame);
   std::uint64_t dropped() const { return drops_; }
 
  private:
   struct Peer {
     std::uint64_t frame = 0;
     bool dropped = false;
+    std::chrono::steady_clock::time_point heard;
   };
   void post(std::uint64_t frame);
   transport::Publisher& pub_;
@@ -57,6 +61,7 @@ class SwapBarrier {
   std::function<bool()> stopping_;
   std::map<std::string, Peer> peers_;
   std::uint64_t drops_ = 0;
+  std::chrono::steady_clock::time_point last_post_;
 };
 
 }  // namespace mannequin::render_node
