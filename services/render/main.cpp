@@ -4,6 +4,7 @@
 //   otherwise:  a GLFW window (needs a display); --from plays the recording at its own pace, looping.
 //   --connect:  the live sim.world of publishers (newest state; headless: a frame per new state).
 //               A wall view with `head_body` takes its eye from that rigid body of mocap.frame (same endpoints).
+//   sync: true (view file): live headless nodes swap in lockstep (swap_barrier.hpp).
 //   --publish:  a node of a deployment (mannequin-launch passes --name, --publish, --connect): heartbeats
 //               (health.heartbeat) on that endpoint, like every service.
 #include <GLFW/glfw3.h>
