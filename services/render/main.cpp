@@ -22,10 +22,12 @@
 
 #include <spdlog/spdlog.h>
 
+#include "mannequin/core/clock.hpp"
 #include "mannequin/core/config.hpp"
 #include "mannequin/core/main.hpp"
 #include "mannequin/core/paths.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
+#include "mannequin/render/overlay.hpp"
 #include "mannequin/render/renderer.hpp"
 #include "mannequin/render/view.hpp"
 #include "mannequin/simservice/config.hpp"
@@ -52,6 +54,7 @@ struct Options {
   std::vector<std::string> publish;  // --publish: where heartbeats go (the launcher passes the endpoint)
   double duration = 0;               // live: s of wall time (0: until SIGINT/SIGTERM or --frames)
   bool headless = false;
+  bool overlay = false;  // --overlay: the text line (frame, render fps, sim lateness)
   int every = 1;
   long long frames = 0;  // 0: all
 };
@@ -91,6 +94,39 @@ class NodeLink {
   zmq::context_t context_;
   std::unique_ptr<transport::Publisher> pub_;
   std::unique_ptr<transport::HealthReporter> health_;
+};
+
+/// The overlay's text line: the sim.world step and time; live also the render fps (frames drawn per
+/// second, smoothed) and the sim lateness (now − the state's send time, ms). Recordings show neither, so
+/// their frames stay deterministic.
+class OverlayText {
+ public:
+  std::string line(const v1::WorldState& ws, bool live) {
+    char buf[160];
+    if (!live) {
+      std::snprintf(buf, sizeof buf, "FRAME %llu  T %.3f S", static_cast<unsigned long long>(ws.step()), ws.sim_time());
+      return buf;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (last_) {
+      const double dt = std::chrono::duration<double>(now - *last_).count();
+      if (dt > 0) fps_ = fps_ <= 0 ? 1.0 / dt : 0.9 * fps_ + 0.1 / dt;
+    }
+    last_ = now;
+    const std::int64_t sent = ws.header().send_time_ns();
+    const double late_ms = sent > 0 ? static_cast<double>(core::wallNs() - sent) * 1e-6 : 0.0;
+    std::snprintf(buf, sizeof buf, "FRAME %llu  FPS %.1f  LATE %.1f MS", static_cast<unsigned long long>(ws.step()), fps_,
+                  late_ms);
+    return buf;
+  }
+  static void draw(render::Renderer& r, const std::string& text, int w, int h) {
+    const float height = std::max(8.0f, static_cast<float>(h) / 40.0f);
+    r.drawOverlay(render::strokeText(text, height, height, height), w, h, {1.0f, 1.0f, 1.0f, 1.0f});
+  }
+
+ private:
+  std::optional<std::chrono::steady_clock::time_point> last_;
+  double fps_ = 0;
 };
 
 /// Geometry: the sim config's scene and mannequins, or --scene; models not named there are looked up as
@@ -225,8 +261,11 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
   const render::Camera cam = view.camera(w, h);
   std::set<std::string> tried;
   long long written = 0;
-  const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index) {
+  OverlayText overlay;
+  const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index,
+                        const v1::WorldState* ws, bool live) {
     renderer.draw(scene, camera, w, h, view.background);
+    if (o.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), w, h);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06zu.png", index);
     render::writePng((fs::path(o.out) / name).string(), ctx.read());
@@ -278,6 +317,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       if (ws->step() != step) spdlog::warn("swap barrier: step {} missed here; drawing step {}", step, ws->step());
       addMissingModels(*ws, assets, tried);
       renderer.draw(render::buildScene(*ws, assets, view.style), live.camera(view, w, h), w, h, view.background);
+      if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
       const render::Image img = ctx.read();
       barrier.arriveAndWait(step);
       // the swap: the frame goes out now
@@ -303,11 +343,12 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       const long long index = states++;
       if (index % o.every != 0) continue;
       addMissingModels(live.latest(), assets, tried);
-      emit(render::buildScene(live.latest(), assets, view.style), live.camera(view, w, h), static_cast<std::size_t>(index));
+      emit(render::buildScene(live.latest(), assets, view.style), live.camera(view, w, h), static_cast<std::size_t>(index),
+           &live.latest(), true);
     }
   } else if (o.from.empty()) {
     // neither a recording nor publishers: the static scene, once
-    emit(render::buildStaticScene(assets, view.style), cam, 0);
+    emit(render::buildStaticScene(assets, view.style), cam, 0, nullptr, false);
   } else {
     const std::vector<v1::WorldState> states = readRecording(o.from);
     if (states.empty()) {
@@ -317,7 +358,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     for (std::size_t i = 0; i < states.size(); i += static_cast<std::size_t>(o.every)) {
       if (o.frames > 0 && written >= o.frames) break;
       addMissingModels(states[i], assets, tried);
-      emit(render::buildScene(states[i], assets, view.style), cam, i);
+      emit(render::buildScene(states[i], assets, view.style), cam, i, &states[i], false);
     }
   }
   std::printf("wrote %lld frames (%dx%d) to %s\n", written, w, h, o.out.c_str());
@@ -355,6 +396,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
   }
   glfwMakeContextCurrent(win);
   glfwSwapInterval(1);
+  if (view.sync) spdlog::warn("{}: sync: true is not implemented for windows yet (headless nodes only); ignored", view.source);
   std::vector<v1::WorldState> states;
   if (!o.from.empty()) states = readRecording(o.from);
   std::unique_ptr<LiveWorld> live;
@@ -388,6 +430,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
     const auto& stop = core::installStopSignals();
     const render::RenderScene still = render::buildStaticScene(assets, view.style);
     long long swapped = 0;
+    OverlayText overlay;
     while (!glfwWindowShouldClose(win) && !stop.load()) {
       int w = 0, h = 0;
       glfwGetFramebufferSize(win, &w, &h);
@@ -401,6 +444,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         } else {
           addMissingModels(live->latest(), assets, tried);
           renderer.draw(render::buildScene(live->latest(), assets, view.style), cam, w, h, view.background);
+          if (o.overlay) OverlayText::draw(renderer, overlay.line(live->latest(), true), w, h);
         }
       } else if (states.empty()) {
         renderer.draw(still, cam, w, h, view.background);
@@ -412,6 +456,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         while (i + 1 < states.size() && states[i + 1].sim_time() <= t) ++i;
         addMissingModels(states[i], assets, tried);
         renderer.draw(render::buildScene(states[i], assets, view.style), cam, w, h, view.background);
+        if (o.overlay) OverlayText::draw(renderer, overlay.line(states[i], false), w, h);
       }
       glfwSwapBuffers(win);
       glfwPollEvents();
@@ -443,6 +488,8 @@ int main(int argc, char** argv) {
   app.add_option("--duration", o.duration, "live: stop after S seconds (0: at --frames or SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--from", o.from, "render the sim.world messages of this MCAP recording")->excludes(connect);
+  app.add_flag("--overlay", o.overlay,
+               "draw the text line: sim.world step and time (recording), or step, render fps and sim lateness (live)");
   app.add_flag("--headless", o.headless, "render off-screen into PNG frames (needs --out)");
   app.add_option("--size", o.size, "headless image size WIDTHxHEIGHT (default: the view's size)")
       ->check([](const std::string& s) {

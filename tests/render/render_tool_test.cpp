@@ -143,7 +143,15 @@ TEST(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
   ASSERT_EQ(rc.status, 0) << rc.err;
   EXPECT_EQ(std::distance(fs::directory_iterator(c), fs::directory_iterator{}), 2);
   EXPECT_NE(rc.out.find("wrote 2 frames (160x120)"), std::string::npos) << rc.out;
-  for (const fs::path& d : {a, b, c}) fs::remove_all(d);
+  // --overlay (a recording: step and sim time only) is deterministic too, and draws something
+  const fs::path d = temp("d"), e = temp("e");
+  ASSERT_EQ(run(common + " --every 2 --overlay --out " + d.string()).status, 0);
+  ASSERT_EQ(run(common + " --every 2 --overlay --out " + e.string()).status, 0);
+  for (const auto& n : names) {
+    EXPECT_EQ(slurp(d / n), slurp(e / n)) << n << " with --overlay differs between two runs";
+    EXPECT_NE(slurp(d / n), slurp(a / n)) << n << " is the same with and without --overlay";
+  }
+  for (const fs::path& dir : {a, b, c, d, e}) fs::remove_all(dir);
   fs::remove(mcap);
 }
 
