@@ -4,7 +4,7 @@
 //   otherwise:  a GLFW window (needs a display); --from plays the recording at its own pace, looping.
 //   --connect:  the live sim.world of publishers (newest state; headless: a frame per new state).
 //               A wall view with `head_body` takes its eye from that rigid body of mocap.frame (same endpoints).
-//   sync: true (view file): live headless nodes swap in lockstep (swap_barrier.hpp).
+//   sync: true (view file): live nodes (headless or windows) swap in lockstep (swap_barrier.hpp).
 //   --publish:  a node of a deployment (mannequin-launch passes --name, --publish, --connect): heartbeats
 //               (health.heartbeat) on that endpoint, like every service.
 #include <GLFW/glfw3.h>
@@ -13,6 +13,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <map>
 #include <memory>
@@ -243,6 +244,34 @@ class LiveWorld {
   std::optional<render::Camera> camera_;
 };
 
+/// Synchronised nodes: the step to draw next (the leader's newest state, or as a follower the leader's
+/// post), or nullopt when there is none yet this turn (waited a little; call again). The state is in
+/// live.stateAt(step) (a missed step gives the newest before it, with a warning).
+std::optional<std::uint64_t> syncPick(render_node::SwapBarrier& barrier, LiveWorld& live, std::uint64_t last,
+                                      double timeout_s, const std::function<bool()>& over) {
+  std::uint64_t step = 0;
+  if (barrier.isLeader()) {
+    live.poll(std::chrono::milliseconds(5));
+    if (live.newestStep() <= last) {
+      barrier.keepAlive(last);
+      return std::nullopt;
+    }
+    step = live.newestStep();
+  } else {
+    const auto f = barrier.awaitLeader(last, [&] { return live.newestStep() > last; });
+    if (!f) return std::nullopt;
+    step = *f;
+    // the leader's state normally arrived already (same publisher); wait for it up to the timeout
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (live.newestStep() < step && std::chrono::steady_clock::now() < until && !over())
+      live.poll(std::chrono::milliseconds(2));
+  }
+  const v1::WorldState* ws = live.stateAt(step);
+  if (ws == nullptr) return std::nullopt;
+  if (ws->step() != step) spdlog::warn("swap barrier: step {} missed here; drawing step {}", step, ws->step());
+  return step;
+}
+
 int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets, NodeLink& link) {
   int w = view.width, h = view.height;
   if (!o.size.empty()) {
@@ -295,26 +324,10 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     std::uint64_t last = 0;
     while (!over()) {
       link.service(written);
-      std::uint64_t step = 0;
-      if (barrier.isLeader()) {
-        live.poll(std::chrono::milliseconds(5));
-        if (live.newestStep() <= last) {
-          barrier.keepAlive(last);
-          continue;
-        }
-        step = live.newestStep();
-      } else {
-        const auto f = barrier.awaitLeader(last, [&] { return live.newestStep() > last; });
-        if (!f) continue;
-        step = *f;
-        // the leader's state normally arrived already (same publisher); wait for it up to the timeout
-        const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(view.sync_timeout);
-        while (live.newestStep() < step && std::chrono::steady_clock::now() < until && !over())
-          live.poll(std::chrono::milliseconds(2));
-      }
+      const auto picked = syncPick(barrier, live, last, view.sync_timeout, over);
+      if (!picked) continue;
+      const std::uint64_t step = *picked;
       const v1::WorldState* ws = live.stateAt(step);
-      if (ws == nullptr) continue;
-      if (ws->step() != step) spdlog::warn("swap barrier: step {} missed here; drawing step {}", step, ws->step());
       addMissingModels(*ws, assets, tried);
       renderer.draw(render::buildScene(*ws, assets, view.style), live.camera(view, w, h), w, h, view.background);
       if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
@@ -396,7 +409,12 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
   }
   glfwMakeContextCurrent(win);
   glfwSwapInterval(1);
-  if (view.sync) spdlog::warn("{}: sync: true is not implemented for windows yet (headless nodes only); ignored", view.source);
+  if (view.sync && (o.connect.empty() || link.publisher() == nullptr)) {
+    glfwDestroyWindow(win);
+    glfwTerminate();
+    spdlog::error("{}: sync: true needs --connect (live) and --publish ENDPOINT (the node's render.sync)", view.source);
+    return core::kExitUsage;
+  }
   std::vector<v1::WorldState> states;
   if (!o.from.empty()) states = readRecording(o.from);
   std::unique_ptr<LiveWorld> live;
@@ -431,7 +449,50 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
     const render::RenderScene still = render::buildStaticScene(assets, view.style);
     long long swapped = 0;
     OverlayText overlay;
-    while (!glfwWindowShouldClose(win) && !stop.load()) {
+    if (view.sync) {
+      // synchronised: draw the barrier's step, swap once every live peer drew it (swaps.log in --out if given)
+      const auto over = [&] {
+        return glfwWindowShouldClose(win) || stop.load() || (o.frames > 0 && swapped >= o.frames) ||
+               (o.duration > 0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= o.duration);
+      };
+      render_node::SwapBarrier barrier(
+          *link.publisher(), o.name, view.sync_timeout,
+          [&](std::chrono::microseconds t) {
+            live->poll(t);
+            glfwPollEvents();
+          },
+          over);
+      live->subscriber().subscribe(transport::topics::kRenderSync, [&](const v1::RenderSync& m) { barrier.onMessage(m); });
+      std::ofstream log;
+      if (!o.out.empty()) {
+        fs::create_directories(o.out);
+        log.open(fs::path(o.out) / "swaps.log");
+      }
+      barrier.greet();
+      std::uint64_t last = 0;
+      while (!over()) {
+        link.service(swapped);
+        glfwPollEvents();
+        const auto picked = syncPick(barrier, *live, last, view.sync_timeout, over);
+        if (!picked) continue;
+        const v1::WorldState* ws = live->stateAt(*picked);
+        int w = 0, h = 0;
+        glfwGetFramebufferSize(win, &w, &h);
+        render::ViewConfig v = view;
+        v.orbit = orbit;
+        addMissingModels(*ws, assets, tried);
+        renderer.draw(render::buildScene(*ws, assets, view.style), live->camera(v, w, h), w, h, view.background);
+        if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+        glFinish();
+        barrier.arriveAndWait(*picked);
+        glfwSwapBuffers(win);
+        if (log.is_open()) log << *picked << ' ' << std::chrono::steady_clock::now().time_since_epoch().count() << '\n' << std::flush;
+        ++swapped;
+        link.frameDrawn();
+        last = *picked;
+      }
+    }
+    while (!view.sync && !glfwWindowShouldClose(win) && !stop.load()) {
       int w = 0, h = 0;
       glfwGetFramebufferSize(win, &w, &h);
       render::ViewConfig v = view;

@@ -421,6 +421,58 @@ TEST(RenderTool, SyncedNodesSwapTheSameStepsAndADeadNodeStallsNoLongerThanTheTim
   for (const fs::path& d : dirs) fs::remove_all(d);
 }
 
+TEST(RenderTool, SyncedWindowsSwapTheStepsAHeadlessNodeSwaps) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); windows with sync are not tested";
+  WorldPublisher world(std::chrono::milliseconds(2));
+  const fs::path view = temp("sync_win_view.yaml"), ipc = temp("ipc_win");
+  fs::create_directories(ipc);
+  std::ofstream(view) << "type: desktop\nsize: [96, 96]\nsync: true\nsync_timeout: 0.3\n";
+  const std::vector<std::string> names{"win_b", "win_c", "wall_a"};  // two windows, then one headless node
+  std::vector<fs::path> dirs;
+  std::vector<pid_t> pids;
+  for (const std::string& n : names) {
+    dirs.push_back(temp("syncwin_" + n));
+    const bool window = n != "wall_a";
+    std::vector<std::string> args;
+    if (window) args = {"xvfb-run", "-a"};
+    args.insert(args.end(), {toolPath().string(), "--view", view.string(), "--name", n, "--publish",
+                             "ipc://" + (ipc / n).string(), "--connect", world.endpoint(), "--out", dirs.back().string(),
+                             "--duration", "6", "--log-level", "warn"});
+    if (!window) args.insert(args.end(), {"--headless", "--size", "64x64"});
+    for (const std::string& peer : names)
+      if (peer != n) args.insert(args.end(), {"--connect", "ipc://" + (ipc / peer).string()});
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    ASSERT_EQ(::posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
+    pids.push_back(pid);
+  }
+  for (std::size_t i = 0; i < pids.size(); ++i) {
+    const int st = reap(pids[i], 60);
+    EXPECT_TRUE(st != -1 && WIFEXITED(st) && WEXITSTATUS(st) == 0) << names[i];
+  }
+  const auto b = swaps(dirs[0]), c = swaps(dirs[1]), a = swaps(dirs[2]);
+  ASSERT_FALSE(a.empty());
+  ASSERT_FALSE(b.empty());
+  ASSERT_FALSE(c.empty());
+  const std::uint64_t first = std::max({a.front().first, b.front().first, c.front().first});
+  const std::uint64_t last = std::min({a.back().first, b.back().first, c.back().first});
+  const auto steps = [&](const auto& v) {
+    std::vector<std::uint64_t> s;
+    for (const auto& [step, t] : v)
+      if (step >= first && step <= last) s.push_back(step);
+    return s;
+  };
+  EXPECT_GE(steps(a).size(), 10u);
+  EXPECT_EQ(steps(a), steps(b));
+  EXPECT_EQ(steps(a), steps(c));
+  fs::remove(view);
+  fs::remove_all(ipc);
+  for (const fs::path& d : dirs) fs::remove_all(d);
+}
+
 TEST(RenderTool, OpensAWindowUnderXvfb) {
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); the window path is not tested";
