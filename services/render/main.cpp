@@ -4,30 +4,41 @@
 //   otherwise:  a GLFW window (needs a display); --from plays the recording at its own pace, looping.
 //   --connect:  the live sim.world of publishers (newest state; headless: a frame per new state).
 //               A wall view with `head_body` takes its eye from that rigid body of mocap.frame (same endpoints).
-// Not yet (issue 14, later steps): the service kit (heartbeats, launcher), the swap barrier.
+//   sync: true (view file): live nodes (headless or windows) swap in lockstep (swap_barrier.hpp).
+//   --publish:  a node of a deployment (mannequin-launch passes --name, --publish, --connect): heartbeats
+//               (health.heartbeat) on that endpoint, like every service.
 #include <GLFW/glfw3.h>
 
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
+#include <functional>
+#include <fstream>
+#include <map>
+#include <memory>
 #include <optional>
 #include <set>
 #include <thread>
 
 #include <spdlog/spdlog.h>
 
+#include "mannequin/core/clock.hpp"
 #include "mannequin/core/config.hpp"
 #include "mannequin/core/main.hpp"
 #include "mannequin/core/paths.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
+#include "mannequin/render/overlay.hpp"
 #include "mannequin/render/renderer.hpp"
 #include "mannequin/render/view.hpp"
 #include "mannequin/simservice/config.hpp"
+#include "mannequin/transport/health.hpp"
+#include "mannequin/transport/publisher.hpp"
 #include "mannequin/transport/subscriber.hpp"
 #include "mannequin/transport/topics.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/v1/world.pb.h"
+#include "swap_barrier.hpp"
 
 using namespace mannequin;
 namespace fs = std::filesystem;
@@ -40,10 +51,83 @@ struct Options {
   std::string view = "configs/views/desktop.yaml";
   std::string sim, scene, from, out, size;
   std::vector<std::string> connect;  // live sim.world publishers
+  std::string name = "render";       // --name: heartbeat name (the launcher passes the service name)
+  std::vector<std::string> publish;  // --publish: where heartbeats go (the launcher passes the endpoint)
   double duration = 0;               // live: s of wall time (0: until SIGINT/SIGTERM or --frames)
   bool headless = false;
+  bool overlay = false;  // --overlay: the text line (frame, render fps, sim lateness)
   int every = 1;
   long long frames = 0;  // 0: all
+};
+
+/// The node on the network: the ZeroMQ context of its sockets and, with --publish (a node of a deployment),
+/// its publisher and heartbeats (state RUNNING while it draws, frames counted in the loop rate).
+class NodeLink {
+ public:
+  explicit NodeLink(const Options& o) {
+    if (o.publish.empty()) return;
+    pub_ = std::make_unique<transport::Publisher>(context_, transport::PublisherOptions{o.name, o.publish});
+    health_ = std::make_unique<transport::HealthReporter>(*pub_, o.name);
+    health_->setState(v1::SERVICE_STATE_RUNNING);
+    health_->tick(true);
+  }
+  ~NodeLink() {
+    if (!health_) return;
+    health_->setState(v1::SERVICE_STATE_STOPPING);
+    health_->tick(true);
+  }
+  NodeLink(const NodeLink&) = delete;
+  NodeLink& operator=(const NodeLink&) = delete;
+  /// Once per loop iteration (a frame drawn or a wait): subscriptions, heartbeat when due.
+  void service(long long frames) {
+    if (!health_) return;
+    health_->setStat("frames", static_cast<double>(frames));
+    pub_->poll();
+    health_->tick();
+  }
+  void frameDrawn() {
+    if (health_) health_->loopIteration();
+  }
+  zmq::context_t& context() { return context_; }
+  transport::Publisher* publisher() { return pub_.get(); }
+
+ private:
+  zmq::context_t context_;
+  std::unique_ptr<transport::Publisher> pub_;
+  std::unique_ptr<transport::HealthReporter> health_;
+};
+
+/// The overlay's text line: the sim.world step and time; live also the render fps (frames drawn per
+/// second, smoothed) and the sim lateness (now − the state's send time, ms). Recordings show neither, so
+/// their frames stay deterministic.
+class OverlayText {
+ public:
+  std::string line(const v1::WorldState& ws, bool live) {
+    char buf[160];
+    if (!live) {
+      std::snprintf(buf, sizeof buf, "FRAME %llu  T %.3f S", static_cast<unsigned long long>(ws.step()), ws.sim_time());
+      return buf;
+    }
+    const auto now = std::chrono::steady_clock::now();
+    if (last_) {
+      const double dt = std::chrono::duration<double>(now - *last_).count();
+      if (dt > 0) fps_ = fps_ <= 0 ? 1.0 / dt : 0.9 * fps_ + 0.1 / dt;
+    }
+    last_ = now;
+    const std::int64_t sent = ws.header().send_time_ns();
+    const double late_ms = sent > 0 ? static_cast<double>(core::wallNs() - sent) * 1e-6 : 0.0;
+    std::snprintf(buf, sizeof buf, "FRAME %llu  FPS %.1f  LATE %.1f MS", static_cast<unsigned long long>(ws.step()), fps_,
+                  late_ms);
+    return buf;
+  }
+  static void draw(render::Renderer& r, const std::string& text, int w, int h) {
+    const float height = std::max(8.0f, static_cast<float>(h) / 40.0f);
+    r.drawOverlay(render::strokeText(text, height, height, height), w, h, {1.0f, 1.0f, 1.0f, 1.0f});
+  }
+
+ private:
+  std::optional<std::chrono::steady_clock::time_point> last_;
+  double fps_ = 0;
 };
 
 /// Geometry: the sim config's scene and mannequins, or --scene; models not named there are looked up as
@@ -94,12 +178,24 @@ std::vector<v1::WorldState> readRecording(const std::string& path) {
 /// re-sends its last state to a late subscriber, so a node shows the current scene at once).
 class LiveWorld {
  public:
-  LiveWorld(const std::vector<std::string>& endpoints, const render::ViewConfig& view)
-      : sub_(context_, transport::SubscriberOptions{"render", endpoints}) {
-    sub_.subscribe(transport::topics::kSimWorld, [this](const v1::WorldState& ws) {
-      latest_ = ws;
-      ++received_;
-    });
+  LiveWorld(zmq::context_t& context, const std::vector<std::string>& endpoints, const render::ViewConfig& view)
+      : sub_(context, transport::SubscriberOptions{"render", endpoints}) {
+    if (view.sync) {
+      // the swap barrier shows the leader's step: every state is kept (queue delivery), the last kRing by step
+      static constexpr transport::Topic<v1::WorldState> kWorldQueued{transport::topics::kSimWorld.name,
+                                                                      transport::Delivery::kQueue};
+      sub_.subscribe(kWorldQueued, [this](const v1::WorldState& ws) {
+        latest_ = ws;
+        ++received_;
+        ring_[ws.step()] = ws;
+        if (ring_.size() > kRing) ring_.erase(ring_.begin());
+      });
+    } else {
+      sub_.subscribe(transport::topics::kSimWorld, [this](const v1::WorldState& ws) {
+        latest_ = ws;
+        ++received_;
+      });
+    }
     if (!view.head_body.empty())  // a wall with a tracked head: its eye follows that rigid body of mocap.frame
       sub_.subscribe(transport::topics::kMocapFrame, [this, &view](const v1::MocapFrame& f) {
         if (const auto h = render::trackedHead(f, view)) head_ = h;
@@ -126,9 +222,21 @@ class LiveWorld {
   }
   const v1::WorldState& latest() const { return latest_; }
   long long received() const { return received_; }
+  transport::Subscriber& subscriber() { return sub_; }
+  /// Sync mode: the newest step received (0: none yet).
+  std::uint64_t newestStep() const { return ring_.empty() ? 0 : ring_.rbegin()->first; }
+  /// Sync mode: the state of step `step`, or (missed: dropped upstream or out of the ring) the newest one
+  /// before it, else the oldest kept; nullptr when nothing arrived.
+  const v1::WorldState* stateAt(std::uint64_t step) const {
+    if (ring_.empty()) return nullptr;
+    auto it = ring_.upper_bound(step);
+    if (it == ring_.begin()) return &it->second;
+    return &std::prev(it)->second;
+  }
 
  private:
-  zmq::context_t context_;
+  static constexpr std::size_t kRing = 512;
+  std::map<std::uint64_t, v1::WorldState> ring_;
   transport::Subscriber sub_;
   v1::WorldState latest_;
   long long received_ = 0, seen_ = 0;
@@ -136,7 +244,35 @@ class LiveWorld {
   std::optional<render::Camera> camera_;
 };
 
-int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets) {
+/// Synchronised nodes: the step to draw next (the leader's newest state, or as a follower the leader's
+/// post), or nullopt when there is none yet this turn (waited a little; call again). The state is in
+/// live.stateAt(step) (a missed step gives the newest before it, with a warning).
+std::optional<std::uint64_t> syncPick(render_node::SwapBarrier& barrier, LiveWorld& live, std::uint64_t last,
+                                      double timeout_s, const std::function<bool()>& over) {
+  std::uint64_t step = 0;
+  if (barrier.isLeader()) {
+    live.poll(std::chrono::milliseconds(5));
+    if (live.newestStep() <= last) {
+      barrier.keepAlive(last);
+      return std::nullopt;
+    }
+    step = live.newestStep();
+  } else {
+    const auto f = barrier.awaitLeader(last, [&] { return live.newestStep() > last; });
+    if (!f) return std::nullopt;
+    step = *f;
+    // the leader's state normally arrived already (same publisher); wait for it up to the timeout
+    const auto until = std::chrono::steady_clock::now() + std::chrono::duration<double>(timeout_s);
+    while (live.newestStep() < step && std::chrono::steady_clock::now() < until && !over())
+      live.poll(std::chrono::milliseconds(2));
+  }
+  const v1::WorldState* ws = live.stateAt(step);
+  if (ws == nullptr) return std::nullopt;
+  if (ws->step() != step) spdlog::warn("swap barrier: step {} missed here; drawing step {}", step, ws->step());
+  return step;
+}
+
+int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets, NodeLink& link) {
   int w = view.width, h = view.height;
   if (!o.size.empty()) {
     const auto s = render::parseSize(o.size);
@@ -154,30 +290,78 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
   const render::Camera cam = view.camera(w, h);
   std::set<std::string> tried;
   long long written = 0;
-  const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index) {
+  OverlayText overlay;
+  const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index,
+                        const v1::WorldState* ws, bool live) {
     renderer.draw(scene, camera, w, h, view.background);
+    if (o.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), w, h);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06zu.png", index);
     render::writePng((fs::path(o.out) / name).string(), ctx.read());
     ++written;
+    link.frameDrawn();
+    link.service(written);
   };
-  if (!o.connect.empty()) {
+  if (!o.connect.empty() && view.sync) {
+    // live, synchronised: the swap barrier picks the step (the leader's newest); frames are named by that
+    // step and each swap is logged in DIR/swaps.log ("step steady_ns"), so nodes can be compared
+    if (link.publisher() == nullptr) {
+      spdlog::error("{}: sync: true needs --publish ENDPOINT (the node's render.sync; mannequin-launch passes it)", view.source);
+      return core::kExitUsage;
+    }
+    LiveWorld live(link.context(), o.connect, view);
+    const auto& stop = core::installStopSignals();
+    const auto start = std::chrono::steady_clock::now();
+    const auto over = [&] {
+      return stop.load() || (o.frames > 0 && written >= o.frames) ||
+             (o.duration > 0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= o.duration);
+    };
+    render_node::SwapBarrier barrier(
+        *link.publisher(), o.name, view.sync_timeout, [&](std::chrono::microseconds t) { live.poll(t); }, over);
+    live.subscriber().subscribe(transport::topics::kRenderSync, [&](const v1::RenderSync& m) { barrier.onMessage(m); });
+    std::ofstream log(fs::path(o.out) / "swaps.log");
+    barrier.greet();
+    std::uint64_t last = 0;
+    while (!over()) {
+      link.service(written);
+      const auto picked = syncPick(barrier, live, last, view.sync_timeout, over);
+      if (!picked) continue;
+      const std::uint64_t step = *picked;
+      const v1::WorldState* ws = live.stateAt(step);
+      addMissingModels(*ws, assets, tried);
+      renderer.draw(render::buildScene(*ws, assets, view.style), live.camera(view, w, h), w, h, view.background);
+      if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+      const render::Image img = ctx.read();
+      barrier.arriveAndWait(step);
+      // the swap: the frame goes out now
+      char name[64];
+      std::snprintf(name, sizeof name, "frame_%06llu.png", static_cast<unsigned long long>(step));
+      render::writePng((fs::path(o.out) / name).string(), img);
+      log << step << ' ' << std::chrono::steady_clock::now().time_since_epoch().count() << '\n' << std::flush;
+      ++written;
+      link.frameDrawn();
+      last = step;
+    }
+    spdlog::info("swap barrier: {} peers at the end, {} drops", barrier.peers(), barrier.dropped());
+  } else if (!o.connect.empty()) {
     // live: a frame per new state (every Nth), named by its arrival count, until --frames, --duration or a signal
-    LiveWorld live(o.connect, view);
+    LiveWorld live(link.context(), o.connect, view);
     const auto& stop = core::installStopSignals();
     const auto start = std::chrono::steady_clock::now();
     long long states = 0;
     while (!stop.load() && (o.frames <= 0 || written < o.frames) &&
            (o.duration <= 0 || std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() < o.duration)) {
+      link.service(written);
       if (!live.poll(std::chrono::milliseconds(100))) continue;
       const long long index = states++;
       if (index % o.every != 0) continue;
       addMissingModels(live.latest(), assets, tried);
-      emit(render::buildScene(live.latest(), assets, view.style), live.camera(view, w, h), static_cast<std::size_t>(index));
+      emit(render::buildScene(live.latest(), assets, view.style), live.camera(view, w, h), static_cast<std::size_t>(index),
+           &live.latest(), true);
     }
   } else if (o.from.empty()) {
     // neither a recording nor publishers: the static scene, once
-    emit(render::buildStaticScene(assets, view.style), cam, 0);
+    emit(render::buildStaticScene(assets, view.style), cam, 0, nullptr, false);
   } else {
     const std::vector<v1::WorldState> states = readRecording(o.from);
     if (states.empty()) {
@@ -187,7 +371,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     for (std::size_t i = 0; i < states.size(); i += static_cast<std::size_t>(o.every)) {
       if (o.frames > 0 && written >= o.frames) break;
       addMissingModels(states[i], assets, tried);
-      emit(render::buildScene(states[i], assets, view.style), cam, i);
+      emit(render::buildScene(states[i], assets, view.style), cam, i, &states[i], false);
     }
   }
   std::printf("wrote %lld frames (%dx%d) to %s\n", written, w, h, o.out.c_str());
@@ -200,7 +384,7 @@ struct Mouse {
   bool left = false, right = false;
 };
 
-int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets) {
+int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets, NodeLink& link) {
   const char* x11 = std::getenv("DISPLAY");
   const char* wl = std::getenv("WAYLAND_DISPLAY");
   if ((x11 == nullptr || *x11 == '\0') && (wl == nullptr || *wl == '\0')) {
@@ -225,10 +409,16 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
   }
   glfwMakeContextCurrent(win);
   glfwSwapInterval(1);
+  if (view.sync && (o.connect.empty() || link.publisher() == nullptr)) {
+    glfwDestroyWindow(win);
+    glfwTerminate();
+    spdlog::error("{}: sync: true needs --connect (live) and --publish ENDPOINT (the node's render.sync)", view.source);
+    return core::kExitUsage;
+  }
   std::vector<v1::WorldState> states;
   if (!o.from.empty()) states = readRecording(o.from);
   std::unique_ptr<LiveWorld> live;
-  if (!o.connect.empty()) live = std::make_unique<LiveWorld>(o.connect, view);
+  if (!o.connect.empty()) live = std::make_unique<LiveWorld>(link.context(), o.connect, view);
   std::set<std::string> tried;
   int rc = core::kExitOk;
   {
@@ -258,7 +448,51 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
     const auto& stop = core::installStopSignals();
     const render::RenderScene still = render::buildStaticScene(assets, view.style);
     long long swapped = 0;
-    while (!glfwWindowShouldClose(win) && !stop.load()) {
+    OverlayText overlay;
+    if (view.sync) {
+      // synchronised: draw the barrier's step, swap once every live peer drew it (swaps.log in --out if given)
+      const auto over = [&] {
+        return glfwWindowShouldClose(win) || stop.load() || (o.frames > 0 && swapped >= o.frames) ||
+               (o.duration > 0 && std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() >= o.duration);
+      };
+      render_node::SwapBarrier barrier(
+          *link.publisher(), o.name, view.sync_timeout,
+          [&](std::chrono::microseconds t) {
+            live->poll(t);
+            glfwPollEvents();
+          },
+          over);
+      live->subscriber().subscribe(transport::topics::kRenderSync, [&](const v1::RenderSync& m) { barrier.onMessage(m); });
+      std::ofstream log;
+      if (!o.out.empty()) {
+        fs::create_directories(o.out);
+        log.open(fs::path(o.out) / "swaps.log");
+      }
+      barrier.greet();
+      std::uint64_t last = 0;
+      while (!over()) {
+        link.service(swapped);
+        glfwPollEvents();
+        const auto picked = syncPick(barrier, *live, last, view.sync_timeout, over);
+        if (!picked) continue;
+        const v1::WorldState* ws = live->stateAt(*picked);
+        int w = 0, h = 0;
+        glfwGetFramebufferSize(win, &w, &h);
+        render::ViewConfig v = view;
+        v.orbit = orbit;
+        addMissingModels(*ws, assets, tried);
+        renderer.draw(render::buildScene(*ws, assets, view.style), live->camera(v, w, h), w, h, view.background);
+        if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+        glFinish();
+        barrier.arriveAndWait(*picked);
+        glfwSwapBuffers(win);
+        if (log.is_open()) log << *picked << ' ' << std::chrono::steady_clock::now().time_since_epoch().count() << '\n' << std::flush;
+        ++swapped;
+        link.frameDrawn();
+        last = *picked;
+      }
+    }
+    while (!view.sync && !glfwWindowShouldClose(win) && !stop.load()) {
       int w = 0, h = 0;
       glfwGetFramebufferSize(win, &w, &h);
       render::ViewConfig v = view;
@@ -271,6 +505,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         } else {
           addMissingModels(live->latest(), assets, tried);
           renderer.draw(render::buildScene(live->latest(), assets, view.style), cam, w, h, view.background);
+          if (o.overlay) OverlayText::draw(renderer, overlay.line(live->latest(), true), w, h);
         }
       } else if (states.empty()) {
         renderer.draw(still, cam, w, h, view.background);
@@ -282,10 +517,14 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         while (i + 1 < states.size() && states[i + 1].sim_time() <= t) ++i;
         addMissingModels(states[i], assets, tried);
         renderer.draw(render::buildScene(states[i], assets, view.style), cam, w, h, view.background);
+        if (o.overlay) OverlayText::draw(renderer, overlay.line(states[i], false), w, h);
       }
       glfwSwapBuffers(win);
       glfwPollEvents();
-      if (o.frames > 0 && ++swapped >= o.frames) break;
+      ++swapped;
+      link.frameDrawn();
+      link.service(swapped);
+      if (o.frames > 0 && swapped >= o.frames) break;
     }
   }
   glfwDestroyWindow(win);
@@ -310,6 +549,8 @@ int main(int argc, char** argv) {
   app.add_option("--duration", o.duration, "live: stop after S seconds (0: at --frames or SIGINT/SIGTERM)")
       ->check(CLI::NonNegativeNumber);
   app.add_option("--from", o.from, "render the sim.world messages of this MCAP recording")->excludes(connect);
+  app.add_flag("--overlay", o.overlay,
+               "draw the text line: sim.world step and time (recording), or step, render fps and sim lateness (live)");
   app.add_flag("--headless", o.headless, "render off-screen into PNG frames (needs --out)");
   app.add_option("--size", o.size, "headless image size WIDTHxHEIGHT (default: the view's size)")
       ->check([](const std::string& s) {
@@ -323,6 +564,9 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out, "directory of the PNG frames (frame_NNNNNN.png, N = message index)");
   app.add_option("--every", o.every, "render every Nth message")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--frames", o.frames, "write at most K frames (0: all); a window closes after K frames")->check(CLI::NonNegativeNumber);
+  app.add_option("--name", o.name, "node name (heartbeats; mannequin-launch passes the service name)")->capture_default_str();
+  app.add_option("--publish", o.publish,
+                 "publish heartbeats on this endpoint (repeatable; mannequin-launch passes the service's endpoint)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical, off")->check(core::logLevelCheck());
   return core::runMain(app, argc, argv, [&] {
     core::setupLogging(log_level);
@@ -335,6 +579,7 @@ int main(int argc, char** argv) {
       spdlog::error("{}", e.what());
       return core::kExitUsage;
     }
-    return o.headless ? runHeadless(o, view, assets) : runWindow(o, view, assets);
+    NodeLink link(o);
+    return o.headless ? runHeadless(o, view, assets, link) : runWindow(o, view, assets, link);
   });
 }

@@ -71,7 +71,7 @@ TEST(Deployment, ErrorsNameFileLineAndField) {
 }
 
 TEST(Deployment, ShippedDeploymentsParse) {
-  for (const char* f : {"configs/deployments/single-host.yaml"}) {
+  for (const char* f : {"configs/deployments/single-host.yaml", "configs/deployments/single-host-view.yaml"}) {
     const Deployment d = loadDeployment(f);
     EXPECT_GE(d.services.size(), 1u) << f;
   }

@@ -202,3 +202,87 @@ TEST_F(Scenes, RenderingIsDeterministicAndWritesAPng) {
 
 }  // namespace
 }  // namespace mannequin::render
+
+namespace mannequin::render {
+namespace {
+
+TEST(StrokeFont, GlyphsCoverDigitsAndLettersAndStayInTheirCell) {
+  for (char c = '0'; c <= '9'; ++c) EXPECT_TRUE(hasGlyph(c)) << c;
+  for (char c = 'A'; c <= 'Z'; ++c) EXPECT_TRUE(hasGlyph(c)) << c;
+  EXPECT_TRUE(hasGlyph('f'));  // lower case as upper case
+  EXPECT_FALSE(hasGlyph(' '));
+  const std::string all = "0123456789ABCDEFGHIJKLMNOPQRSTUVWXYZ.:-/%";
+  const float h = 20;
+  const auto segs = strokeText(all, 5, 7, h);
+  std::vector<int> per(all.size(), 0);
+  for (const Segment2& s : segs) {
+    // the character is the one whose 0.75 h advance cell holds the segment; inside its 2 × 4 grid
+    const int i = static_cast<int>((std::min(s.x0, s.x1) - 5 + 1e-3f) / (0.75f * h));
+    ASSERT_GE(i, 0);
+    ASSERT_LT(i, static_cast<int>(all.size()));
+    ++per[static_cast<std::size_t>(i)];
+    const float x0 = 5 + 0.75f * h * static_cast<float>(i);
+    for (float x : {s.x0, s.x1}) EXPECT_TRUE(x >= x0 - 1e-3f && x <= x0 + 0.5f * h + 1e-3f) << all[static_cast<std::size_t>(i)];
+    for (float y : {s.y0, s.y1}) EXPECT_TRUE(y >= 7 - 1e-3f && y <= 7 + h + 1e-3f) << all[static_cast<std::size_t>(i)];
+  }
+  for (std::size_t i = 0; i < all.size(); ++i) EXPECT_GE(per[i], 1) << all[i];
+  // a space advances without drawing
+  EXPECT_EQ(strokeText("1 1", 0, 0, h).size(), 2 * strokeText("1", 0, 0, h).size());
+  EXPECT_FLOAT_EQ(strokeText("1 1", 0, 0, h).back().x0 - strokeText("1", 0, 0, h).back().x0, 1.5f * h);
+}
+
+class OverlayPixels : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    try {
+      ctx_ = std::make_unique<HeadlessContext>(kW, kH);
+      renderer_ = std::make_unique<Renderer>();
+    } catch (const RenderError& e) {
+      GTEST_SKIP() << "no headless OpenGL 3.3 here (" << e.what() << ")";
+    }
+  }
+  void TearDown() override {
+    if (ctx_) ctx_->makeCurrent();
+    renderer_.reset();
+    ctx_.reset();
+  }
+  Image frame(const std::string& text) {
+    ViewConfig view;
+    renderer_->draw(RenderScene{}, view.camera(kW, kH), kW, kH, {0.1f, 0.1f, 0.1f});
+    if (!text.empty()) renderer_->drawOverlay(strokeText(text, 10, 10, 16), kW, kH, {1, 1, 1, 1});
+    return ctx_->read();
+  }
+  static bool white(const std::array<std::uint8_t, 3>& c) { return c[0] > 200 && c[1] > 200 && c[2] > 200; }
+  static constexpr int kW = 200, kH = 60;
+  std::unique_ptr<HeadlessContext> ctx_;
+  std::unique_ptr<Renderer> renderer_;
+};
+
+TEST_F(OverlayPixels, TextIsDrawnInsideItsBoxAndTheChangedDigitChangesOnlyItsCell) {
+  const Image none = frame(""), a = frame("FRAME 0123"), b = frame("FRAME 0124");
+  int lit = 0, outside = 0, before = 0;
+  // "FRAME 0123": 10 cells of 12 px from x = 10, rows 10..26 (± 1 px for the line raster)
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      before += white(none.at(x, y)) ? 1 : 0;
+      if (!white(a.at(x, y))) continue;
+      ++lit;
+      if (x < 9 || x > 10 + 10 * 12 + 1 || y < 9 || y > 27) ++outside;
+    }
+  EXPECT_EQ(before, 0);
+  EXPECT_EQ(outside, 0);
+  EXPECT_GE(lit, 9 * 16);  // nine glyphs of at least one 16 px stroke each
+  // 3 → 4: the last cell (x in [118, 130]) differs, nothing else
+  int changed = 0, changed_elsewhere = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (white(a.at(x, y)) != white(b.at(x, y))) {
+        ++changed;
+        if (x < 10 + 9 * 12 - 1 || x > 10 + 9 * 12 + 8 + 1) ++changed_elsewhere;
+      }
+  EXPECT_GT(changed, 5);
+  EXPECT_EQ(changed_elsewhere, 0);
+}
+
+}  // namespace
+}  // namespace mannequin::render

@@ -5,7 +5,12 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <signal.h>
+#include <spawn.h>
+
 #include <array>
+#include <chrono>
+#include <map>
 #include <atomic>
 #include <thread>
 #include <cstdio>
@@ -138,7 +143,15 @@ TEST(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
   ASSERT_EQ(rc.status, 0) << rc.err;
   EXPECT_EQ(std::distance(fs::directory_iterator(c), fs::directory_iterator{}), 2);
   EXPECT_NE(rc.out.find("wrote 2 frames (160x120)"), std::string::npos) << rc.out;
-  for (const fs::path& d : {a, b, c}) fs::remove_all(d);
+  // --overlay (a recording: step and sim time only) is deterministic too, and draws something
+  const fs::path d = temp("d"), e = temp("e");
+  ASSERT_EQ(run(common + " --every 2 --overlay --out " + d.string()).status, 0);
+  ASSERT_EQ(run(common + " --every 2 --overlay --out " + e.string()).status, 0);
+  for (const auto& n : names) {
+    EXPECT_EQ(slurp(d / n), slurp(e / n)) << n << " with --overlay differs between two runs";
+    EXPECT_NE(slurp(d / n), slurp(a / n)) << n << " is the same with and without --overlay";
+  }
+  for (const fs::path& dir : {a, b, c, d, e}) fs::remove_all(dir);
   fs::remove(mcap);
 }
 
@@ -228,6 +241,236 @@ TEST(RenderTool, AWallWithATrackedHeadDrawsWhatAFixedHeadThereDraws) {
   EXPECT_EQ(slurp(frames.back()), slurp(ref / "frame_000000.png"));
   for (const fs::path& p : {fixed, tracked, mcap}) fs::remove(p);
   for (const fs::path& d : {live, ref}) fs::remove_all(d);
+}
+
+// A publisher thread sending a standing mannequin with step i every `period` until stopped.
+class WorldPublisher {
+ public:
+  explicit WorldPublisher(std::chrono::milliseconds period = std::chrono::milliseconds(20))
+      : pub_(ctx_, {"sim", {"tcp://127.0.0.1:0"}}), endpoint_(pub_.boundEndpoints().at(0)) {
+    thread_ = std::thread([this, period] {
+      const skeleton::Model model = testing::male50();
+      for (std::uint64_t i = 1; !done_.load(); ++i) {
+        v1::WorldState ws;
+        ws.set_step(i);
+        math::VectorX q = skeleton::standingConfiguration(model);
+        q(1) += 0.01 * static_cast<double>(i % 50);
+        testing::addMannequin(ws, model, q, "alice");
+        pub_.publish(transport::topics::kSimWorld, ws);
+        pub_.poll();
+        std::this_thread::sleep_for(period);
+      }
+    });
+  }
+  ~WorldPublisher() {
+    done_ = true;
+    thread_.join();
+  }
+  const std::string& endpoint() const { return endpoint_; }
+
+ private:
+  zmq::context_t ctx_;
+  transport::Publisher pub_;
+  std::string endpoint_;
+  std::atomic<bool> done_{false};
+  std::thread thread_;
+};
+
+TEST(RenderTool, TheLauncherRunsARenderNodeLikeAnyService) {
+  WorldPublisher world;
+  const fs::path run_dir = temp("run"), out = temp("launched"), file = temp("deployment.yaml"), summary = temp("summary.json");
+  fs::create_directories(run_dir);
+  std::ofstream(file) << "name: render-test\nrun_dir: " << run_dir.string() << "\nservices:\n"
+                      << "  - name: wall\n    exec: " << toolPath().string() << "\n"
+                      << "    args: [--view, configs/views/desktop.yaml, --headless, --size, 96x96, --connect, " << world.endpoint()
+                      << ", --out, " << out.string() << "]\n"
+                      << "    publish: ipc://${RUN_DIR}/wall\n";
+  const fs::path launch = toolPath().parent_path() / "mannequin-launch";
+  const std::string cmd = "timeout 60 " + launch.string() + " " + file.string() + " --duration 3 --summary-json " +
+                          summary.string() + " >/dev/null 2>&1";
+  const int st = std::system(cmd.c_str());
+  ASSERT_TRUE(WIFEXITED(st)) << cmd;
+  EXPECT_EQ(WEXITSTATUS(st), 0) << cmd;
+  const std::string json = slurp(summary);
+  // the launcher saw the node's heartbeats (started with --name wall --publish ipc://RUN_DIR/wall)
+  const auto at = json.find("\"name\": \"wall\"");
+  ASSERT_NE(at, std::string::npos) << json;
+  const auto hb = json.find("\"heartbeats\": ", at);
+  ASSERT_NE(hb, std::string::npos) << json;
+  EXPECT_GT(std::stol(json.substr(hb + 14)), 0) << json;
+  const auto frames = json.find("\"frames\": ", at);
+  ASSERT_NE(frames, std::string::npos) << json;
+  EXPECT_GT(std::stod(json.substr(frames + 10)), 0.0) << json;
+  EXPECT_GT(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 0);
+  for (const fs::path& p : {file, summary}) fs::remove(p);
+  for (const fs::path& d : {run_dir, out}) fs::remove_all(d);
+}
+
+// One swap per line of DIR/swaps.log: "step steady_ns".
+std::vector<std::pair<std::uint64_t, std::int64_t>> swaps(const fs::path& dir) {
+  std::vector<std::pair<std::uint64_t, std::int64_t>> out;
+  std::ifstream in(dir / "swaps.log");
+  std::uint64_t step;
+  std::int64_t t;
+  while (in >> step >> t) out.emplace_back(step, t);
+  return out;
+}
+
+// Waits (deadline) until every dir's swaps.log has at least n[i] lines; false at the deadline.
+bool awaitSwaps(const std::vector<fs::path>& dirs, const std::vector<std::size_t>& n, double deadline_s) {
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(deadline_s);
+  while (std::chrono::steady_clock::now() < end) {
+    bool all = true;
+    for (std::size_t i = 0; i < dirs.size(); ++i) all = all && swaps(dirs[i]).size() >= n[i];
+    if (all) return true;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));  // a poll interval, not a synchronisation
+  }
+  return false;
+}
+
+// Waits for a child with a deadline; SIGKILL at the deadline. Returns the wait status (-1 if none).
+int reap(pid_t pid, double deadline_s) {
+  if (pid <= 0) return -1;
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(deadline_s);
+  int st = 0;
+  while (std::chrono::steady_clock::now() < end) {
+    const pid_t r = ::waitpid(pid, &st, WNOHANG);
+    if (r == pid) return st;
+    if (r < 0) return -1;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  ::kill(pid, SIGKILL);
+  ::waitpid(pid, &st, 0);
+  return -1;
+}
+
+TEST(RenderTool, SyncedNodesSwapTheSameStepsAndADeadNodeStallsNoLongerThanTheTimeout) {
+  // a state every 2 ms: faster than a node draws, so each node's newest state differs at any moment and
+  // only the barrier makes them swap the same steps
+  WorldPublisher world(std::chrono::milliseconds(2));
+  const double timeout = 0.3;
+  const fs::path view = temp("sync_view.yaml"), ipc = temp("ipc");
+  fs::create_directories(ipc);
+  std::ofstream(view) << "type: desktop\nsync: true\nsync_timeout: " << timeout << "\n";
+  const std::vector<std::string> names{"wall_a", "wall_b", "wall_c"};
+  std::vector<fs::path> dirs;
+  std::vector<pid_t> pids;
+  for (const std::string& n : names) {
+    dirs.push_back(temp("sync_" + n));
+    std::vector<std::string> args{toolPath().string(), "--view", view.string(), "--headless", "--size", "64x64",
+                                  "--name", n, "--publish", "ipc://" + (ipc / n).string(), "--connect", world.endpoint(),
+                                  "--out", dirs.back().string(), "--duration", "90", "--log-level", "warn"};
+    for (const std::string& peer : names)
+      if (peer != n) args.insert(args.end(), {"--connect", "ipc://" + (ipc / peer).string()});
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    ASSERT_EQ(::posix_spawn(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
+    pids.push_back(pid);
+  }
+  // all three swap 15 frames
+  const bool started = awaitSwaps(dirs, {15, 15, 15}, 60);
+  // the leader (smallest name) dies
+  const auto kill_ns = std::chrono::steady_clock::now().time_since_epoch().count();
+  if (pids[0] > 0) ::kill(pids[0], SIGKILL);
+  reap(pids[0], 10);
+  const std::size_t at_kill_b = swaps(dirs[1]).size(), at_kill_c = swaps(dirs[2]).size();
+  // the others go on: 15 more swaps each
+  const bool went_on = awaitSwaps({dirs[1], dirs[2]}, {at_kill_b + 15, at_kill_c + 15}, 60);
+  for (std::size_t i = 1; i < pids.size(); ++i)
+    if (pids[i] > 0) ::kill(pids[i], SIGTERM);
+  for (std::size_t i = 1; i < pids.size(); ++i) EXPECT_NE(reap(pids[i], 20), -1) << names[i] << " did not stop on SIGTERM";
+  ASSERT_TRUE(started) << "the three nodes did not swap 15 frames each within 60 s";
+  ASSERT_TRUE(went_on) << "the two nodes left stalled after the leader was killed";
+
+  const auto a = swaps(dirs[0]), b = swaps(dirs[1]), c = swaps(dirs[2]);
+  const auto steps = [](const auto& v, std::uint64_t lo, std::uint64_t hi) {
+    std::vector<std::uint64_t> s;
+    for (const auto& [step, t] : v)
+      if (step >= lo && step <= hi) s.push_back(step);
+    return s;
+  };
+  // every step wall_a swapped, wall_b and wall_c swapped too (over the range all three ran)
+  const std::uint64_t first = std::max({a.front().first, b.front().first, c.front().first});
+  const std::vector<std::uint64_t> sa = steps(a, first, a.back().first);
+  EXPECT_GE(sa.size(), 10u);
+  for (const auto& other : {b, c}) {
+    const std::vector<std::uint64_t> so = steps(other, first, a.back().first);
+    for (std::uint64_t s : sa) EXPECT_TRUE(std::binary_search(so.begin(), so.end(), s)) << "step " << s;
+  }
+  // wall_b and wall_c swapped the same steps, before and after the kill
+  const std::uint64_t last = std::min(b.back().first, c.back().first);
+  const std::vector<std::uint64_t> sb = steps(b, first, last), sc = steps(c, first, last);
+  EXPECT_EQ(sb, sc);
+  EXPECT_GE(sb.size(), 25u);
+  // steps only go forward
+  for (const auto& v : {a, b, c})
+    for (std::size_t i = 1; i < v.size(); ++i) EXPECT_LT(v[i - 1].first, v[i].first);
+  // the stall at the kill: the longest gap between two swaps of a survivor after the kill stays within a
+  // few timeouts (leader silent: one timeout; the barrier of that frame: at most one more), far from forever
+  for (const auto& v : {b, c}) {
+    double worst = 0;
+    for (std::size_t i = 1; i < v.size(); ++i)
+      if (v[i].second > kill_ns) worst = std::max(worst, static_cast<double>(v[i].second - v[i - 1].second) * 1e-9);
+    std::printf("longest gap between two swaps after the kill: %.3f s (timeout %.1f s)\n", worst, timeout);
+    EXPECT_LT(worst, 4 * timeout + 1.0) << "a survivor stalled " << worst << " s";
+  }
+  fs::remove(view);
+  fs::remove_all(ipc);
+  for (const fs::path& d : dirs) fs::remove_all(d);
+}
+
+TEST(RenderTool, SyncedWindowsSwapTheStepsAHeadlessNodeSwaps) {
+  if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); windows with sync are not tested";
+  WorldPublisher world(std::chrono::milliseconds(2));
+  const fs::path view = temp("sync_win_view.yaml"), ipc = temp("ipc_win");
+  fs::create_directories(ipc);
+  std::ofstream(view) << "type: desktop\nsize: [96, 96]\nsync: true\nsync_timeout: 0.3\n";
+  const std::vector<std::string> names{"win_b", "win_c", "wall_a"};  // two windows, then one headless node
+  std::vector<fs::path> dirs;
+  std::vector<pid_t> pids;
+  for (const std::string& n : names) {
+    dirs.push_back(temp("syncwin_" + n));
+    const bool window = n != "wall_a";
+    std::vector<std::string> args;
+    if (window) args = {"xvfb-run", "-a"};
+    args.insert(args.end(), {toolPath().string(), "--view", view.string(), "--name", n, "--publish",
+                             "ipc://" + (ipc / n).string(), "--connect", world.endpoint(), "--out", dirs.back().string(),
+                             "--duration", "6", "--log-level", "warn"});
+    if (!window) args.insert(args.end(), {"--headless", "--size", "64x64"});
+    for (const std::string& peer : names)
+      if (peer != n) args.insert(args.end(), {"--connect", "ipc://" + (ipc / peer).string()});
+    std::vector<char*> argv;
+    for (std::string& a : args) argv.push_back(a.data());
+    argv.push_back(nullptr);
+    pid_t pid = 0;
+    ASSERT_EQ(::posix_spawnp(&pid, argv[0], nullptr, nullptr, argv.data(), environ), 0);
+    pids.push_back(pid);
+  }
+  for (std::size_t i = 0; i < pids.size(); ++i) {
+    const int st = reap(pids[i], 60);
+    EXPECT_TRUE(st != -1 && WIFEXITED(st) && WEXITSTATUS(st) == 0) << names[i];
+  }
+  const auto b = swaps(dirs[0]), c = swaps(dirs[1]), a = swaps(dirs[2]);
+  ASSERT_FALSE(a.empty());
+  ASSERT_FALSE(b.empty());
+  ASSERT_FALSE(c.empty());
+  const std::uint64_t first = std::max({a.front().first, b.front().first, c.front().first});
+  const std::uint64_t last = std::min({a.back().first, b.back().first, c.back().first});
+  const auto steps = [&](const auto& v) {
+    std::vector<std::uint64_t> s;
+    for (const auto& [step, t] : v)
+      if (step >= first && step <= last) s.push_back(step);
+    return s;
+  };
+  EXPECT_GE(steps(a).size(), 10u);
+  EXPECT_EQ(steps(a), steps(b));
+  EXPECT_EQ(steps(a), steps(c));
+  fs::remove(view);
+  fs::remove_all(ipc);
+  for (const fs::path& d : dirs) fs::remove_all(d);
 }
 
 TEST(RenderTool, OpensAWindowUnderXvfb) {

@@ -105,3 +105,22 @@ TEST(ViewConfig, TrackedHeadIsTheHeadBodysPoseTimesTheOffset) {
 
 }  // namespace
 }  // namespace mannequin::render
+
+namespace mannequin::render {
+namespace {
+
+TEST(ViewConfig, SyncAndItsTimeout) {
+  const ViewConfig off = parseView("type: desktop\n", "v.yaml");
+  EXPECT_FALSE(off.sync);
+  EXPECT_DOUBLE_EQ(off.sync_timeout, 0.5);
+  const ViewConfig on = parseView("type: desktop\nsync: true\nsync_timeout: 0.25\n", "v.yaml");
+  EXPECT_TRUE(on.sync);
+  EXPECT_DOUBLE_EQ(on.sync_timeout, 0.25);
+  const std::string bad = errorOf("type: desktop\nsync: true\nsync_timeout: 0\n");
+  EXPECT_NE(bad.find("v.yaml:3"), std::string::npos) << bad;
+  EXPECT_NE(bad.find("sync_timeout"), std::string::npos) << bad;
+  EXPECT_NE(errorOf("type: desktop\nsync: maybe\n").find("v.yaml:2"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace mannequin::render

@@ -298,4 +298,34 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
   glUseProgram(0);
 }
 
+void Renderer::drawOverlay(const std::vector<Segment2>& segments, int width, int height, const Colour& colour) {
+  if (segments.empty() || width <= 0 || height <= 0) return;
+  glViewport(0, 0, width, height);
+  glDisable(GL_DEPTH_TEST);
+  glUseProgram(program_);
+  glUniform1i(u_unlit_, 1);
+  const Eigen::Matrix4f id4 = Eigen::Matrix4f::Identity();
+  glUniformMatrix4fv(u_mvp_, 1, GL_FALSE, id4.data());
+  const Eigen::Matrix3f id3 = Eigen::Matrix3f::Identity();
+  glUniformMatrix3fv(u_normal_, 1, GL_FALSE, id3.data());
+  std::vector<float> v;
+  v.reserve(segments.size() * 12);
+  const auto ndc = [&](float x, float y) {
+    // pixel centres: x + 0.5, rows from the top
+    return Eigen::Vector3d(2.0 * (x + 0.5) / width - 1.0, 1.0 - 2.0 * (y + 0.5) / height, 0.0);
+  };
+  for (const Segment2& s : segments) {
+    push(v, ndc(s.x0, s.y0), Eigen::Vector3d::UnitZ());
+    push(v, ndc(s.x1, s.y1), Eigen::Vector3d::UnitZ());
+  }
+  glBindVertexArray(line_vao_);
+  glBindBuffer(GL_ARRAY_BUFFER, line_vbo_);
+  glBufferData(GL_ARRAY_BUFFER, static_cast<GLsizeiptr>(v.size() * sizeof(float)), v.data(), GL_STREAM_DRAW);
+  glUniform4f(u_colour_, colour[0], colour[1], colour[2], colour[3]);
+  glDrawArrays(GL_LINES, 0, static_cast<GLsizei>(2 * segments.size()));
+  glBindVertexArray(0);
+  glUseProgram(0);
+  glEnable(GL_DEPTH_TEST);
+}
+
 }  // namespace mannequin::render

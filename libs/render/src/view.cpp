@@ -18,7 +18,9 @@ ViewConfig fromNode(const core::ConfigNode& root) {
   ViewConfig v;
   v.source = root.file();
   root.allowOnly({"name", "type", "size", "background", "camera", "wall", "head", "head_body", "head_offset", "near",
-                  "far", "style"});
+                  "far", "style", "sync", "sync_timeout"});
+  if (auto y = root.find("sync")) v.sync = y->boolean();
+  v.sync_timeout = root.getIn("sync_timeout", v.sync_timeout, 0.01, 60.0);
   v.name = root.get("name", v.name);
   if (!root.has("type")) root.fail("missing key 'type' (desktop or wall)");
   v.type = root["type"].choice({"desktop", "wall"}) == 0 ? ViewConfig::Type::kDesktop : ViewConfig::Type::kWall;

@@ -21,6 +21,8 @@
 #include "mannequin/render/camera.hpp"
 #include "mannequin/render/scene.hpp"
 
+#include "mannequin/render/overlay.hpp"
+
 namespace mannequin::render {
 
 /// A failure of the OpenGL or EGL layer (no context, a shader that does not compile, an incomplete FBO).
@@ -55,6 +57,10 @@ class Renderer {
   /// Clears the current framebuffer's viewport (0, 0, width, height) to `background` and draws the scene.
   void draw(const RenderScene& scene, const Camera& camera, int width, int height,
             const std::array<float, 3>& background);
+
+  /// Draws 2D line segments in pixels (rows from the top; see overlay.hpp) over what the framebuffer
+  /// holds (no clear, no depth test), in `colour`. Call after draw() with the same size.
+  void drawOverlay(const std::vector<Segment2>& segments, int width, int height, const Colour& colour);
 
   /// GL_RENDERER and GL_VERSION of the current context ("llvmpipe (LLVM 15.0.6, 256 bits) | 4.5 (Core Profile) Mesa ...").
   static std::string describeContext();

@@ -47,6 +47,8 @@ struct ViewConfig {
   Vec3 head_offset = Vec3::Zero();  ///< kWall: the eye in head_body's frame (m)
   double near_plane = 0.05, far_plane = 100.0;  ///< kWall (the orbit camera has its own)
   Style style;
+  bool sync = false;            ///< `sync: true`: live nodes pass the swap barrier (render.sync) before each swap
+  double sync_timeout = 0.5;    ///< `sync_timeout`: s a node waits for a peer that is late or dead before going on
 
   /// The camera of this view for an image of width × height (desktop: the orbit camera at that aspect;
   /// wall: the off-axis frustum from `head`, independent of the image size).
