@@ -174,17 +174,7 @@ TEST(Allocation, LemkeWarmStartAllocatesNothing) {
   const Index n = 40;
   const auto c = gen::makeContactLike(n, 3);
   const Eigen::MatrixXd M = c.A * c.A.transpose();
-  class Dense final : public LcpMatrixOperator {
-   public:
-    explicit Dense(const Eigen::MatrixXd& m) : m_(m) {}
-    Index size() const override { return m_.rows(); }
-    void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const override { out = m_.col(j); }
-    void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override { out.noalias() = m_ * z; }
-    double maxAbs() const override { return m_.cwiseAbs().maxCoeff(); }
-
-   private:
-    const Eigen::MatrixXd& m_;
-  } op(M);
+  const DenseOperator op(M);
   LemkeWorkspace ws;
   ws.reserve(n);
   LcpResult r;

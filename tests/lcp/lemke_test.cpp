@@ -459,19 +459,6 @@ TEST(Lemke, ProductFormRestartsDenseWhenItsEtaFileIsFull) {
 }
 
 namespace {
-// a dense M as an operator (the warm start's entry takes one)
-class DenseOperator final : public LcpMatrixOperator {
- public:
-  explicit DenseOperator(const Eigen::MatrixXd& M) : M_(M) {}
-  Index size() const override { return M_.rows(); }
-  void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const override { out = M_.col(j); }
-  void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override { out.noalias() = M_ * z; }
-  double maxAbs() const override { return M_.cwiseAbs().maxCoeff(); }
-
- private:
-  const Eigen::MatrixXd& M_;
-};
-
 std::vector<std::uint8_t> basisOf(const LemkeWorkspace& ws, Index n) { return {ws.basis(), ws.basis() + n}; }
 }  // namespace
 

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "mannequin/lcp/lcp.hpp"
+#include "mannequin/lcp/lemke.hpp"
 
 namespace mannequin::lcp::gen {
 
@@ -136,3 +137,20 @@ inline ContactLike makeContactLike(Index n, std::uint32_t seed, double regulariz
 }
 
 }  // namespace mannequin::lcp::gen
+
+namespace mannequin::lcp {
+
+/// A dense M (kept by reference) as an LcpMatrixOperator, for the operator entries of Lemke in tests.
+class DenseOperator final : public LcpMatrixOperator {
+ public:
+  explicit DenseOperator(const Eigen::MatrixXd& M) : M_(M) {}
+  Index size() const override { return M_.rows(); }
+  void column(Index j, Eigen::Ref<Eigen::VectorXd> out) const override { out = M_.col(j); }
+  void multiply(const VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override { out.noalias() = M_ * z; }
+  double maxAbs() const override { return M_.size() > 0 ? M_.cwiseAbs().maxCoeff() : 0.0; }
+
+ private:
+  const Eigen::MatrixXd& M_;
+};
+
+}  // namespace mannequin::lcp
