@@ -89,14 +89,14 @@ class TestHand final : public cs::ConstrainedSystem, public cs::BodyFrames {
   TestHand(const SE3& pose, double b_rot, double b_lin) : target_(pose), pose_(pose) {
     b_ = Eigen::MatrixXd::Zero(6, 6);
     b_.diagonal() << b_rot, b_rot, b_rot, b_lin, b_lin, b_lin;
-    llt_.compute(b_);
+    factor_.compute(b_);
     qdot_free_ = Eigen::VectorXd::Zero(6);
     qdot_ = qdot_free_;
     gamma_ = qdot_free_;
   }
   int nv() const override { return 6; }
   const Eigen::VectorXd& qdotFree() const override { return qdot_free_; }
-  const Eigen::LLT<Eigen::MatrixXd>& frictionLLT() const override { return llt_; }
+  const mannequin::math::TreeCholesky& frictionFactor() const override { return factor_; }
   void applyConstraintForce(const Eigen::VectorXd& g) override {
     gamma_ = g;
     qdot_ += b_.diagonal().cwiseInverse().cwiseProduct(g);
@@ -123,7 +123,7 @@ class TestHand final : public cs::ConstrainedSystem, public cs::BodyFrames {
  private:
   SE3 pose_;
   Eigen::MatrixXd b_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
+  mannequin::math::TreeCholesky factor_ = mannequin::math::TreeCholesky::dense(6);
   Eigen::VectorXd qdot_free_, qdot_, gamma_;
 };
 

@@ -21,11 +21,13 @@ class PointSystem final : public ConstrainedSystem {
   PointSystem(int dim, int points, double mass, double tau)
       : dim_(dim), m_(mass), tau_(tau), x(Eigen::VectorXd::Zero(dim * points)),
         qdot(Eigen::VectorXd::Zero(dim * points)), qdot_free_(Eigen::VectorXd::Zero(dim * points)),
-        llt_((mass / tau) * Eigen::MatrixXd::Identity(dim * points, dim * points)),
-        applied(Eigen::VectorXd::Zero(dim * points)) {}
+        factor_(mannequin::math::TreeCholesky::dense(dim * points)),
+        applied(Eigen::VectorXd::Zero(dim * points)) {
+    factor_.compute((mass / tau) * Eigen::MatrixXd::Identity(dim * points, dim * points));
+  }
   int nv() const override { return static_cast<int>(x.size()); }
   const Eigen::VectorXd& qdotFree() const override { return qdot_free_; }
-  const Eigen::LLT<Eigen::MatrixXd>& frictionLLT() const override { return llt_; }
+  const mannequin::math::TreeCholesky& frictionFactor() const override { return factor_; }
   void applyConstraintForce(const Eigen::VectorXd& gamma_c) override {
     applied += gamma_c;
     qdot.noalias() += (tau_ / m_) * gamma_c;
@@ -47,7 +49,7 @@ class PointSystem final : public ConstrainedSystem {
 
  private:
   Eigen::VectorXd qdot_free_;
-  Eigen::LLT<Eigen::MatrixXd> llt_;
+  mannequin::math::TreeCholesky factor_;
 
  public:
   Eigen::VectorXd applied;  ///< Σ Γ_c of this step

@@ -86,7 +86,7 @@ lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
       problem_.q(r) = Jc_.row(r).dot(qdot_f) + std::max(d / dt, -options_.recovery_speed);
     }
     BinvJcT_ = Jc_.transpose();
-    ctl.apparentFrictionLLT().solveInPlace(BinvJcT_);  // b⁻¹ J_cᵀ
+    ctl.apparentFrictionFactor().solveInPlace(BinvJcT_);  // b⁻¹ J_cᵀ
     problem_.M.noalias() = Jc_ * BinvJcT_;
     lcp::solveLemke(problem_, workspace_, lcp::LemkeOptions{}, res);
     if (res.status != lcp::LcpStatus::Solved) {

@@ -44,7 +44,7 @@ std::vector<int> systemSizes(const std::vector<ConstrainedSystem*>& systems, con
 
 }  // namespace
 
-// The step's LCP matrix, never formed: M = [Σ_s X_sᵀ X_s  0; 0 0] (force rows; X_s = L_s⁻¹ R_sᵀ) plus
+// The step's LCP matrix, never formed: M = [Σ_s X_sᵀ X_s  0; 0 0] (force rows; X_s = L_s⁻ᵀ R_sᵀ) plus
 // the friction structure (w_edge = … + γ, w_γ = μλ − Σβ): Lemke's product form reads only the
 // columns of the variables entering its basis, O(n Σ nv_s) each, instead of the O(n² Σ nv_s) product.
 class DelassusOperator final : public lcp::LcpMatrixOperator {
@@ -143,7 +143,7 @@ struct ConstraintSolver::Impl {
   int cap_n = 0, cap_f = 0, cap_nn = 0;  // LCP, force rows, frictionless rows
   int m_total = 0;                       // Σ nv_s
   std::vector<Eigen::MatrixXd> Rt;       // per system: nv_s × cap_f, force rows R_s (transposed)
-  std::vector<Eigen::MatrixXd> X;        // per system: nv_s × cap_f, L_s⁻¹ R_sᵀ
+  std::vector<Eigen::MatrixXd> X;        // per system: nv_s × cap_f, L_s⁻ᵀ R_sᵀ
   std::vector<Eigen::VectorXd> gamma;    // per system: nv_s, Γ_s
   std::vector<Eigen::VectorXd> velocity; // per system: nv_s, q̇_s of the current answer (refinement)
   std::vector<int> pos, neg, edge, gam;  // per row: index of λ (+ half), − half, first edge, γ
@@ -154,7 +154,7 @@ struct ConstraintSolver::Impl {
   Eigen::VectorXd q;                     // cap_n
   Eigen::VectorXd q_base;                // cap_n: q without the distance terms (refinement)
   Eigen::VectorXd z_prev;                // cap_n: the answer before a re-solve (refinement)
-  Eigen::MatrixXd A;                     // cap_nn × Σ nv_s: frictionless A = [R_s L_s⁻ᵀ]_s
+  Eigen::MatrixXd A;                     // cap_nn × Σ nv_s: frictionless A = [R_s L_s⁻¹]_s
   lcp::LcpResult result;                 // cap_n
   // warm start: the basis guessed from the previous step's answer (rows matched by RowKey)
   struct RowKey {
@@ -362,7 +362,7 @@ const SolveReport& ConstraintSolver::solve(double dt) {
     q.setZero();
     auto diag = im.diag.head(nF);
     diag.setZero();
-    // force rows per touched system, X_s = L_s⁻¹ R_sᵀ (the Delassus matrix Σ_s X_sᵀ X_s is not formed:
+    // force rows per touched system, X_s = L_s⁻ᵀ R_sᵀ (the Delassus matrix Σ_s X_sᵀ X_s is not formed:
     // DelassusOperator), q = R q̇_free + d/δt
     for (int s = 0; s < ns; ++s) {
       if (!((touched >> s) & 1u)) continue;
@@ -384,30 +384,10 @@ const SolveReport& ConstraintSolver::solve(double dt) {
       }
       auto X = im.X[us].leftCols(nF);
       X = Rt;
-      // L⁻¹ Rᵀ. Few columns (the usual step: feet, limits): forward substitution per column, an axpy
-      // of L's column per nonzero (at nv ≈ 40 Eigen's blocked triangular solve spends most of its
-      // time packing). Many: in panels of kPanel columns, Eigen's blocked kernels then keep their
-      // packing buffers on the stack (under EIGEN_STACK_ALLOCATION_LIMIT) instead of allocating them
-      const Eigen::LLT<Eigen::MatrixXd>& llt = systems_[us]->frictionLLT();
-      if (nF <= kPanel) {
-        const Eigen::MatrixXd& L = llt.matrixLLT();
-        const Eigen::Index nvs = L.rows();
-        for (int c = 0; c < nF; ++c) {
-          auto x = X.col(c);
-          for (Eigen::Index j = 0; j < nvs; ++j) {
-            if (x(j) == 0.0) continue;  // the leading zeros of a row on a limb's columns stay zero
-            x(j) /= L(j, j);
-            const Eigen::Index below = nvs - j - 1;
-            x.tail(below) -= x(j) * L.col(j).tail(below);
-          }
-        }
-      } else {
-        const auto L = llt.matrixL();
-        for (int c0 = 0; c0 < nF; c0 += kPanel) {
-          auto Xc = X.middleCols(c0, std::min(kPanel, nF - c0));
-          L.solveInPlace(Xc);
-        }
-      }
+      // X = L⁻ᵀ Rᵀ (b = Lᵀ L along the tree of coordinates): a row on a body keeps the support of
+      // the coordinates moving that body, so each column costs its branch's depth², not nv²
+      const math::TreeCholesky& factor = systems_[us]->frictionFactor();
+      for (int c = 0; c < nF; ++c) factor.halfSolveInPlace(X.col(c));
       diag += X.colwise().squaredNorm().transpose();
       q.head(nF).noalias() += Rt.transpose() * systems_[us]->qdotFree();
     }
@@ -482,7 +462,7 @@ const SolveReport& ConstraintSolver::solve(double dt) {
           Eigen::VectorXd& v = im.velocity[us];
           if ((touched >> s) & 1u) {
             v.noalias() = im.Rt[us].leftCols(nF) * res.z.head(nF);
-            systems_[us]->frictionLLT().solveInPlace(v);  // b⁻¹Γ
+            systems_[us]->frictionFactor().solveInPlace(v);  // b⁻¹Γ
             v += systems_[us]->qdotFree();
           } else {
             v = systems_[us]->qdotFree();
@@ -518,7 +498,7 @@ const SolveReport& ConstraintSolver::solve(double dt) {
       rep.fallback = true;
       ++failures_;
       rep.lcp_size = nN;
-      // frictionless A = [R_s L_s⁻ᵀ]_s
+      // frictionless A = [R_s L_s⁻¹]_s
       int col = 0;
       for (int s = 0; s < ns; ++s) {
         if (!((touched >> s) & 1u)) continue;

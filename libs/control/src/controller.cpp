@@ -175,7 +175,8 @@ void Controller::build(const VectorX& q0) {
   J_.setZero(rows_, nv_);
   JB_.setZero(rows_, nv_);
   b_.setIdentity(nv_, nv_);
-  llt_.compute(b_);  // allocates the factor once (and sets its status, which Eigen leaves unset)
+  factor_ = math::TreeCholesky(model_.velocityParents());
+  factor_.compute(b_);
   wrench_ff_.assign(nf, Vector6::Zero());
   damping_total_.assign(nf, Vector6::Zero());
   vd_c_.assign(nf, Vector6::Zero());
@@ -376,20 +377,7 @@ void Controller::assembleFriction() {
     }
   }
   b_.triangularView<Eigen::StrictlyUpper>() = b_.transpose();
-  llt_.computeUnblocked(b_);
-}
-
-void Controller::FrictionLLT::computeUnblocked(const MatrixX& a) {
-  // as Eigen::LLT::compute (same members: the factor, its L1 norm for rcond(), the status) with
-  // Eigen's unblocked kernel; no allocation once m_matrix has the size
-  const Eigen::Index n = a.rows();
-  m_matrix = a;
-  m_l1_norm = 0.0;
-  for (Eigen::Index col = 0; col < n; ++col)
-    m_l1_norm = std::max(m_l1_norm, m_matrix.col(col).tail(n - col).lpNorm<1>() + m_matrix.row(col).head(col).lpNorm<1>());
-  m_isInitialized = true;
-  const Eigen::Index failed = Eigen::internal::llt_inplace<double, Eigen::Lower>::unblocked(m_matrix);
-  m_info = failed == -1 ? Eigen::Success : Eigen::NumericalIssue;
+  factor_.compute(b_);
 }
 
 void Controller::gramOfTasks() {
@@ -463,9 +451,9 @@ StepStatus Controller::computeFreeMotion() {
   // free motion q̇_free = b⁻¹ Γ (2.19–2.20)
   gamma_ = gamma_task_ + gamma_int_ + gamma_g_;
   qdot_free_ = gamma_;
-  llt_.solveInPlace(qdot_free_);
   gamma_c_.setZero();
-  if (!qdot_free_.allFinite() || llt_.info() != Eigen::Success) {
+  if (factor_.info() == Eigen::Success) factor_.solveInPlace(qdot_free_);
+  if (!qdot_free_.allFinite() || factor_.info() != Eigen::Success) {
     ++non_finite_steps_;
     qdot_free_.setZero();
     qdot_.setZero();
@@ -484,7 +472,7 @@ void Controller::applyConstraintForce(const VectorX& gamma_c) {
   if (!free_motion_ready_) throw std::invalid_argument("applyConstraintForce: call computeFreeMotion() first");
   // q̇ = q̇_free + b⁻¹ J_cᵀ W_c (Alg. 4)
   tmp_ = gamma_c;
-  llt_.solveInPlace(tmp_);
+  factor_.solveInPlace(tmp_);
   qdot_ += tmp_;
   gamma_c_ += gamma_c;
 }
@@ -546,7 +534,8 @@ std::vector<StabilityEntry> Controller::checkStability() {
   // per axis: k δt e_aᵀ J b⁻¹ Jᵀ e_a, i.e. k δt / b_eff along that axis (2.11)
   MatrixX C = MatrixX::Zero(rows_, rows_);  // J b⁻¹ Jᵀ
   if (rows_ > 0) {
-    const MatrixX X = llt_.solve(MatrixX(J_.transpose()));  // b⁻¹ Jᵀ
+    MatrixX X = J_.transpose();
+    factor_.solveInPlace(X);  // b⁻¹ Jᵀ
     C = J_ * X;
   }
   VectorX Ksqrt = VectorX::Zero(rows_);

@@ -49,7 +49,8 @@ RigidObject::RigidObject(const RigidObjectSpec& spec)
     b_.diagonal().tail<3>().setConstant(mass_ / tau_);
   }
   b_inv_ = b_.diagonal().cwiseInverse();
-  llt_.compute(b_);
+  factor_ = math::TreeCholesky(std::vector<int>(static_cast<std::size_t>(nv()), -1));
+  factor_.compute(b_);
   qdot_free_ = Eigen::VectorXd::Zero(nv());
   qdot_ = Eigen::VectorXd::Zero(nv());
 }

@@ -182,6 +182,15 @@ double Model::totalMass() const {
   return m;
 }
 
+std::vector<int> Model::velocityParents() const {
+  std::vector<int> p(static_cast<std::size_t>(nv), -1);
+  for (const Joint& j : joints) {
+    const int up = j.parent >= 0 ? joints[static_cast<std::size_t>(j.parent)].idx_v + joints[static_cast<std::size_t>(j.parent)].nv - 1 : -1;
+    for (int k = 0; k < j.nv; ++k) p[static_cast<std::size_t>(j.idx_v + k)] = k == 0 ? up : j.idx_v + k - 1;
+  }
+  return p;
+}
+
 std::vector<std::string> Model::coordinateNames() const {
   std::vector<std::string> names;
   names.reserve(nq);

@@ -4,11 +4,12 @@
 /// the three stages of Alg. 4 — free motion, constraint forces, integration.
 ///
 /// The solver only needs, at q_k after the free motion: nv, q̇_free, the action of b⁻¹ on columns
-/// (b's Cholesky factor), and a way to add a constraint torque (q̇ = q̇_free + b⁻¹Γ_c). Implementations:
+/// (b's Cholesky factor, along the tree of coordinates), and a way to add a constraint torque (q̇ = q̇_free + b⁻¹Γ_c). Implementations:
 /// MannequinSystem (a control::Controller, below) and sim's rigid objects.
 #include <Eigen/Dense>
 
 #include "mannequin/control/controller.hpp"
+#include "mannequin/math/tree_cholesky.hpp"
 
 namespace mannequin::constraints {
 
@@ -18,8 +19,9 @@ class ConstrainedSystem {
   virtual int nv() const = 0;
   /// q̇_free (nv) of the current step (after the free-motion stage).
   virtual const Eigen::VectorXd& qdotFree() const = 0;
-  /// b's Cholesky factor L (b = L Lᵀ, nv × nv, lower) of the current step.
-  virtual const Eigen::LLT<Eigen::MatrixXd>& frictionLLT() const = 0;
+  /// b's Cholesky factor (b = Lᵀ L along the system's tree of coordinates, math::TreeCholesky) of
+  /// the current step.
+  virtual const math::TreeCholesky& frictionFactor() const = 0;
   /// Adds b⁻¹Γ_c to q̇ (Γ_c: nv, generalised force of the constraints).
   virtual void applyConstraintForce(const Eigen::VectorXd& gamma_c) = 0;
 };
@@ -30,7 +32,7 @@ class MannequinSystem final : public ConstrainedSystem {
   explicit MannequinSystem(control::Controller& controller) : ctl_(&controller) {}
   int nv() const override { return ctl_->model().nv; }
   const Eigen::VectorXd& qdotFree() const override { return ctl_->qdotFree(); }
-  const Eigen::LLT<Eigen::MatrixXd>& frictionLLT() const override { return ctl_->apparentFrictionLLT(); }
+  const math::TreeCholesky& frictionFactor() const override { return ctl_->apparentFrictionFactor(); }
   void applyConstraintForce(const Eigen::VectorXd& gamma_c) override { ctl_->applyConstraintForce(gamma_c); }
   control::Controller& controller() { return *ctl_; }
   const control::Controller& controller() const { return *ctl_; }

@@ -41,6 +41,7 @@
 #include "mannequin/control/energy.hpp"
 #include "mannequin/control/projector.hpp"
 #include "mannequin/control/virtual_mechanism.hpp"
+#include "mannequin/math/tree_cholesky.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 
 namespace mannequin::control {
@@ -140,9 +141,10 @@ class Controller {
   /// Stage 2: q̇ += b⁻¹ Γ_c with Γ_c = J_cᵀ W_c (nv). \throws std::invalid_argument on size/NaN.
   void applyConstraintForce(const VectorX& gamma_c);
   void integrate();                        ///< stage 3
-  /// b = b_a + Σ JᵀBJ at q_k (nv × nv) and its Cholesky factor (reuse it: b⁻¹x = llt.solve(x)).
+  /// b = b_a + Σ JᵀBJ at q_k (nv × nv) and its Cholesky factor b = Lᵀ L along the tree of coordinates
+  /// (reuse it: b⁻¹x by factor.solveInPlace(x)).
   const MatrixX& apparentFriction() const { return b_; }
-  const Eigen::LLT<MatrixX>& apparentFrictionLLT() const { return llt_; }
+  const math::TreeCholesky& apparentFrictionFactor() const { return factor_; }
   const VectorX& qdotFree() const { return qdot_free_; }
   const VectorX& frictionDiagonal() const { return b_a_; }   ///< b_a (nv)
   /// Torques of the last stage 1 (nv each).
@@ -192,12 +194,8 @@ class Controller {
   MatrixX J_;      // (rows × nv) body Jacobians in priority order
   MatrixX JB_;     // (rows × nv) sqrt(B)·J
   MatrixX b_;      // (nv × nv)
-  // Eigen's LLT, factorised by the unblocked algorithm: at nv ≈ 40 Eigen's blocked one (blocks of 8
-  // through its GEMM kernels) costs about three times as much
-  struct FrictionLLT : Eigen::LLT<MatrixX> {
-    void computeUnblocked(const MatrixX& a);
-  };
-  FrictionLLT llt_;
+  // b = Lᵀ L along the model's tree of coordinates (no fill-in: b has the tree's sparsity)
+  math::TreeCholesky factor_;
   // J_ is sparse: a frame's rows are zero off its support columns. b_'s Σ JᵀBJ and the projectors'
   // Gram J b_a⁻¹ Jᵀ are summed over those columns only (frame pairs: the columns both frames share).
   struct FramePair {

@@ -72,7 +72,7 @@ class RigidObject final : public constraints::ConstrainedSystem, public constrai
   // -- ConstrainedSystem --
   int nv() const override { return hinged_ ? 1 : 6; }
   const Eigen::VectorXd& qdotFree() const override { return qdot_free_; }
-  const Eigen::LLT<Eigen::MatrixXd>& frictionLLT() const override { return llt_; }
+  const math::TreeCholesky& frictionFactor() const override { return factor_; }
   void applyConstraintForce(const Eigen::VectorXd& gamma_c) override;
 
   // -- BodyFrames (one body, local 0) --
@@ -105,7 +105,7 @@ class RigidObject final : public constraints::ConstrainedSystem, public constrai
   double theta_ = 0.0;
   Eigen::MatrixXd b_;
   Eigen::VectorXd b_inv_;  // diagonal of b⁻¹
-  Eigen::LLT<Eigen::MatrixXd> llt_;
+  math::TreeCholesky factor_;  // b is diagonal: no parents
   Eigen::VectorXd qdot_free_, qdot_;
   math::Vector3 ext_force_ = math::Vector3::Zero();   // world, at the centre of mass
   math::Vector3 ext_moment_ = math::Vector3::Zero();  // world, about the centre of mass

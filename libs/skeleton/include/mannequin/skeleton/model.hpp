@@ -158,6 +158,10 @@ class Model {
   VectorX neutralConfiguration() const { return VectorX::Zero(nq); }
   /// Names of the nq coordinates, e.g. "knee_l", "hip_l.x", "root.px" (for logs and files).
   std::vector<std::string> coordinateNames() const;
+  /// Parent of each velocity coordinate in the tree of coordinates (nv entries, −1 at the root): the
+  /// previous coordinate of the same joint, else the last coordinate of the parent joint. Two
+  /// coordinates move a common body only if one is an ancestor of the other (math::TreeCholesky).
+  std::vector<int> velocityParents() const;
 };
 
 /// Every buffer the kinematic algorithms write. Build one per Model and thread.
