@@ -174,6 +174,8 @@ struct ConstraintSolver::Impl {
   lcp::StructuredWorkspace structured;
   lcp::PgsWorkspace pgs;
   Index grown = 0;                       // n² buffers hold this size
+  // cos and sin of the edge angles 2πk/m: edge_cs[m][2k], edge_cs[m][2k + 1] (m = 1..max_edges)
+  std::vector<std::vector<double>> edge_cs;
 
   void grow(Index n) {
     if (n <= grown) return;
@@ -240,6 +242,14 @@ ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, cons
   im.prev_edge.assign(mr, -1);
   im.prev_gam.assign(mr, -1);
   im.diag = Eigen::VectorXd::Zero(im.cap_f);
+  im.edge_cs.resize(static_cast<std::size_t>(options.max_edges) + 1);
+  for (int m = 1; m <= options.max_edges; ++m) {
+    for (int k = 0; k < m; ++k) {
+      const double th = 2.0 * std::numbers::pi * k / m;
+      im.edge_cs[static_cast<std::size_t>(m)].push_back(std::cos(th));
+      im.edge_cs[static_cast<std::size_t>(m)].push_back(std::sin(th));
+    }
+  }
   im.q = Eigen::VectorXd::Zero(im.cap_n);
   im.q_base = Eigen::VectorXd::Zero(im.cap_n);
   im.z_prev = Eigen::VectorXd::Zero(im.cap_n);
@@ -376,18 +386,34 @@ const SolveReport& ConstraintSolver::solve(double dt) {
         const int slot = rows_.frictionSlot(r);
         if (slot < 0) continue;
         const int m = rows_.info(r).friction_edges;
-        for (int k = 0; k < m; ++k) {
-          const double th = 2.0 * std::numbers::pi * k / m;
+        const double* cs = im.edge_cs[static_cast<std::size_t>(m)].data();
+        for (int k = 0; k < m; ++k)
           Rt.col(im.edge[ur] + k) =
-              (std::cos(th) * rows_.tangents(s, 0).row(slot) + std::sin(th) * rows_.tangents(s, 1).row(slot)).transpose();
-        }
+              (cs[2 * k] * rows_.tangents(s, 0).row(slot) + cs[2 * k + 1] * rows_.tangents(s, 1).row(slot)).transpose();
       }
-      auto X = im.X[us].leftCols(nF);
-      X = Rt;
       // X = L⁻ᵀ Rᵀ (b = Lᵀ L along the tree of coordinates): a row on a body keeps the support of
-      // the coordinates moving that body, so each column costs its branch's depth², not nv²
+      // the coordinates moving that body, so each solve costs its branch's depth², not nv²; a
+      // bilateral row's − half is −(its + half), a cone's edges are combinations of L⁻ᵀt1 and L⁻ᵀt2
+      auto X = im.X[us].leftCols(nF);
       const math::TreeCholesky& factor = systems_[us]->frictionFactor();
-      for (int c = 0; c < nF; ++c) factor.halfSolveInPlace(X.col(c));
+      Eigen::VectorXd& u1 = im.velocity[us];  // free until the refinement
+      Eigen::VectorXd& u2 = im.gamma[us];     // free until the solve
+      for (int r = 0; r < nr; ++r) {
+        const auto ur = static_cast<std::size_t>(r);
+        auto xp = X.col(im.pos[ur]);
+        xp = Rt.col(im.pos[ur]);
+        factor.halfSolveInPlace(xp);
+        if (im.neg[ur] >= 0) X.col(im.neg[ur]) = -xp;
+        const int slot = rows_.frictionSlot(r);
+        if (slot < 0) continue;
+        const int m = rows_.info(r).friction_edges;
+        const double* cs = im.edge_cs[static_cast<std::size_t>(m)].data();
+        u1 = rows_.tangents(s, 0).row(slot).transpose();
+        u2 = rows_.tangents(s, 1).row(slot).transpose();
+        factor.halfSolveInPlace(u1);
+        factor.halfSolveInPlace(u2);
+        for (int k = 0; k < m; ++k) X.col(im.edge[ur] + k) = cs[2 * k] * u1 + cs[2 * k + 1] * u2;
+      }
       diag += X.colwise().squaredNorm().transpose();
       q.head(nF).noalias() += Rt.transpose() * systems_[us]->qdotFree();
     }
@@ -550,10 +576,10 @@ const SolveReport& ConstraintSolver::solve(double dt) {
     if (im.edge[ur] >= 0 && nz == nF) {
       const int m = in.friction_edges;
       double fx = 0.0, fy = 0.0;
+      const double* cs = im.edge_cs[static_cast<std::size_t>(m)].data();
       for (int k = 0; k < m; ++k) {
-        const double th = 2.0 * std::numbers::pi * k / m;
-        fx += z[im.edge[ur] + k] * std::cos(th);
-        fy += z[im.edge[ur] + k] * std::sin(th);
+        fx += z[im.edge[ur] + k] * cs[2 * k];
+        fy += z[im.edge[ur] + k] * cs[2 * k + 1];
       }
       in.friction = std::hypot(fx, fy);
     }

@@ -8,13 +8,17 @@ namespace mannequin::math {
 
 TreeCholesky::TreeCholesky(std::vector<int> parent) : parent_(std::move(parent)) {
   const int n = size();
+  start_.assign(static_cast<std::size_t>(n) + 1, 0);
   for (int i = 0; i < n; ++i) {
     const int p = parent_[static_cast<std::size_t>(i)];
     if (p < -1 || p >= i)
       throw std::invalid_argument("TreeCholesky: parent[" + std::to_string(i) + "] = " + std::to_string(p) +
                                   ", expected -1 <= parent[i] < i");
+    for (int a = p; a != -1; a = parent_[static_cast<std::size_t>(a)]) anc_.push_back(a);
+    start_[static_cast<std::size_t>(i) + 1] = static_cast<int>(anc_.size());
   }
-  L_.setZero(n, n);
+  d_.setZero(n);
+  l_.setZero(static_cast<Eigen::Index>(anc_.size()));
 }
 
 TreeCholesky TreeCholesky::dense(int n) {
@@ -29,51 +33,75 @@ Eigen::ComputationInfo TreeCholesky::compute(const Eigen::Ref<const MatrixX>& b)
   if (b.rows() != n || b.cols() != n)
     throw std::invalid_argument("TreeCholesky::compute: b is " + std::to_string(b.rows()) + "x" +
                                 std::to_string(b.cols()) + ", expected " + std::to_string(n) + "x" + std::to_string(n));
-  const int* lambda = parent_.data();
-  // the pattern's entries of b (lower triangle: row k, columns k and its ancestors)
+  const int* st = start_.data();
+  const int* anc = anc_.data();
+  double* d = d_.data();
+  double* l = l_.data();
+  // the pattern's entries of b (lower triangle: row k at k and at its ancestors)
   for (int k = 0; k < n; ++k) {
-    L_(k, k) = b(k, k);
-    for (int i = lambda[k]; i != -1; i = lambda[i]) L_(k, i) = b(k, i);
+    d[k] = b(k, k);
+    for (int t = st[k]; t < st[k + 1]; ++t) l[t] = b(k, anc[t]);
   }
-  // RBDA Table 6.3 (LTL): from the leaves to the root
+  // RBDA Table 6.3 (LTL), from the leaves to the root: row k scaled by its pivot, then removed from
+  // the rows of its ancestors (row i = anc(k)[t] spans anc(k)[t+1 ...], the tail of row k)
   for (int k = n - 1; k >= 0; --k) {
-    const double a = L_(k, k);
-    if (!(a > 0.0) || !std::isfinite(a)) {
+    if (!(d[k] > 0.0) || !std::isfinite(d[k])) {
       info_ = Eigen::NumericalIssue;
       return info_;
     }
-    const double d = std::sqrt(a);
-    L_(k, k) = d;
-    for (int i = lambda[k]; i != -1; i = lambda[i]) L_(k, i) /= d;
-    for (int i = lambda[k]; i != -1; i = lambda[i]) {
-      const double lki = L_(k, i);
-      for (int j = i; j != -1; j = lambda[j]) L_(i, j) -= lki * L_(k, j);
+    d[k] = std::sqrt(d[k]);
+    const int cnt = st[k + 1] - st[k];
+    double* lk = l + st[k];
+    for (int t = 0; t < cnt; ++t) lk[t] /= d[k];
+    for (int t = 0; t < cnt; ++t) {
+      const int i = anc[st[k] + t];
+      const double lki = lk[t];
+      d[i] -= lki * lki;
+      double* li = l + st[i];
+      for (int u = 0; u < cnt - t - 1; ++u) li[u] -= lki * lk[t + 1 + u];
     }
   }
   info_ = Eigen::Success;
   return info_;
 }
 
+MatrixX TreeCholesky::matrixL() const {
+  const int n = size();
+  MatrixX L = MatrixX::Zero(n, n);
+  for (int k = 0; k < n; ++k) {
+    L(k, k) = d_[k];
+    for (int t = start_[static_cast<std::size_t>(k)]; t < start_[static_cast<std::size_t>(k) + 1]; ++t)
+      L(k, anc_[static_cast<std::size_t>(t)]) = l_[t];
+  }
+  return L;
+}
+
 void TreeCholesky::halfSolveInPlace(Eigen::Ref<VectorX> x) const {
-  // Lᵀ y = x, from the leaves: column k of Lᵀ holds L_kk and L_ki at k's ancestors i
-  const int* lambda = parent_.data();
+  // Lᵀ y = x, from the leaves: column k of Lᵀ is L_kk and L_ki at k's ancestors i
+  const int* st = start_.data();
+  const int* anc = anc_.data();
+  const double* l = l_.data();
+  double* xp = x.data();
   for (int k = size() - 1; k >= 0; --k) {
-    if (x[k] == 0.0) continue;
-    const double yk = x[k] / L_(k, k);
-    x[k] = yk;
-    for (int i = lambda[k]; i != -1; i = lambda[i]) x[i] -= L_(k, i) * yk;
+    if (xp[k] == 0.0) continue;
+    const double yk = xp[k] / d_[k];
+    xp[k] = yk;
+    for (int t = st[k]; t < st[k + 1]; ++t) xp[anc[t]] -= l[t] * yk;
   }
 }
 
 void TreeCholesky::solveInPlace(Eigen::Ref<VectorX> x) const {
   halfSolveInPlace(x);
-  // L x = y, from the root: row k of L holds L_kk and L_ki at k's ancestors i
-  const int* lambda = parent_.data();
+  // L x = y, from the root: row k of L is L_kk and L_ki at k's ancestors i
+  const int* st = start_.data();
+  const int* anc = anc_.data();
+  const double* l = l_.data();
+  double* xp = x.data();
   const int n = size();
   for (int k = 0; k < n; ++k) {
-    double s = x[k];
-    for (int i = lambda[k]; i != -1; i = lambda[i]) s -= L_(k, i) * x[i];
-    x[k] = s / L_(k, k);
+    double s = xp[k];
+    for (int t = st[k]; t < st[k + 1]; ++t) s -= l[t] * xp[anc[t]];
+    xp[k] = s / d_[k];
   }
 }
 

@@ -35,8 +35,9 @@ class TreeCholesky {
   Eigen::ComputationInfo compute(const Eigen::Ref<const MatrixX>& b);
   Eigen::ComputationInfo info() const { return info_; }
 
-  /// The factor L (lower triangular, b = Lᵀ L); entries off the tree's pattern are zero.
-  const MatrixX& matrixL() const { return L_; }
+  /// The factor L (lower triangular, b = Lᵀ L) as a dense matrix (tests, logs: it is stored by rows
+  /// of ancestors); entries off the tree's pattern are zero.
+  MatrixX matrixL() const;
 
   /// x ← b⁻¹ x (a vector, or each column of a matrix).
   void solveInPlace(Eigen::Ref<VectorX> x) const;
@@ -47,7 +48,10 @@ class TreeCholesky {
 
  private:
   std::vector<int> parent_;
-  MatrixX L_;
+  // row k of L: the diagonal d_[k] and, at [start_[k], start_[k + 1]), the entries L_k,i at k's
+  // ancestors i = anc_[·], nearest first (so the ancestors of the t-th are the ones after it)
+  std::vector<int> start_, anc_;
+  VectorX d_, l_;
   Eigen::ComputationInfo info_ = Eigen::InvalidInput;
 };
 
