@@ -150,6 +150,61 @@ TEST_F(Scenes, AContactForceDrawsAnArrowOfTheForceColourWhereItPointsAndNotWitho
   EXPECT_GT(cam_.pixel(point + force.normalized() * len, kW, kH).x(), cam_.pixel(point, kW, kH).x() + 30);
 }
 
+bool isControlError(const std::array<std::uint8_t, 3>& c) { return c[0] > 200 && c[1] < 100 && c[2] > 150; }
+
+TEST_F(Headless, AControlFrameErrorLineRunsBetweenThePoseAndTheTargetAndVanishesWhenTheyCoincide) {
+  OrbitCamera orbit;
+  orbit.target = Vec3(0, 0.2, 1.0);
+  orbit.distance = 1.6;
+  orbit.yaw = 0.0;  // +y is image right
+  orbit.pitch = 0.0;
+  const Camera cam = orbit.camera(static_cast<double>(kW) / kH);
+  const SE3 actual(Eigen::Matrix3d::Identity(), Vec3(0, 0.0, 1.0));
+  const SE3 target(Eigen::Matrix3d::Identity(), Vec3(0, 0.4, 1.1));
+  v1::WorldState ws;
+  v1::MannequinState* ms = ws.add_mannequins();
+  ms->set_name("alice");
+  testing::addControlFrame(*ms, "hand_r", actual, target);
+  const Image img = render(buildScene(ws, SceneAssets{}), cam);
+  const Eigen::Vector2d pa = cam.pixel(actual.p, kW, kH), pt = cam.pixel(target.p, kW, kH);
+  ASSERT_GT(pt.x() - pa.x(), 60);  // the target is well to the right of the pose
+  Box line;
+  line.add(pa);
+  line.add(pt);
+  int inside = 0, outside = 0;
+  double x_min = 1e9, x_max = -1e9;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (isControlError(img.at(x, y))) {
+        if (!line.contains(x + 0.5, y + 0.5, 1.5)) {
+          ++outside;
+          continue;
+        }
+        ++inside;
+        // on the segment between the projected points (a 1 px line)
+        const Eigen::Vector2d d = (pt - pa).normalized(), r = Eigen::Vector2d(x + 0.5, y + 0.5) - pa;
+        EXPECT_LT(std::abs(d.x() * r.y() - d.y() * r.x()), 1.5) << x << "," << y;
+        x_min = std::min(x_min, x + 0.5);
+        x_max = std::max(x_max, x + 0.5);
+      }
+  EXPECT_EQ(outside, 0);
+  // continuous from near the pose to near the target (the axes may hide a few pixels at either end)
+  EXPECT_GE(inside, 0.8 * (pt.x() - pa.x()));
+  EXPECT_LT(x_min, pa.x() + 0.2 * (pt.x() - pa.x()));
+  EXPECT_GT(x_max, pt.x() - 0.2 * (pt.x() - pa.x()));
+  // target on the pose: no error line anywhere (its axes are still drawn)
+  ms->mutable_control_frames(0)->mutable_target()->CopyFrom(ms->control_frames(0).actual());
+  const Image same = render(buildScene(ws, SceneAssets{}), cam);
+  int error_same = 0, axes_same = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      error_same += isControlError(same.at(x, y)) ? 1 : 0;
+      axes_same += same.at(x, y) != img.at(0, 0) ? 1 : 0;
+    }
+  EXPECT_EQ(error_same, 0);
+  EXPECT_GT(axes_same, 20);
+}
+
 TEST_F(Scenes, TwoWallViewsOfOneFrameAgreeAtTheirSharedEdge) {
   const ViewConfig front = loadView(testing::sourcePath("configs/views/wall_front.yaml"));
   const ViewConfig right = loadView(testing::sourcePath("configs/views/wall_right.yaml"));

@@ -233,6 +233,43 @@ RenderScene buildScene(const v1::WorldState& state, const SceneAssets& assets, c
       s.tag = "com:" + m.name();
       out.solids.push_back(std::move(s));
     }
+    // control frames: achieved pose (shaded axes), target (unlit axes lines), error line between them
+    for (const v1::ControlFrameState& cf : m.control_frames()) {
+      const std::string tag = "control:" + m.name() + "/" + cf.frame();
+      const bool has_actual = cf.has_actual(), has_target = cf.has_target();
+      const SE3 actual = toPose(cf.actual()), target = toPose(cf.target());
+      const double L = style.control_axis_length;
+      if (has_actual) {
+        for (int a = 0; a < 3; ++a) {
+          Primitive c;
+          c.kind = Kind::kCylinder;
+          c.layer = Layer::kControl;
+          c.radius = style.control_axis_radius;
+          c.length = L;
+          const Vector3 axis = actual.R.col(a);
+          c.pose = SE3(math::frameAlong(axis), actual.p + 0.5 * L * axis);
+          c.colour = style.control_axis_colours[static_cast<std::size_t>(a)];
+          c.tag = tag;
+          out.solids.push_back(std::move(c));
+        }
+      }
+      if (has_target) {
+        for (int a = 0; a < 3; ++a) {
+          Polyline l;
+          l.layer = Layer::kControl;
+          l.colour = cf.tracked() ? style.control_target_colours[static_cast<std::size_t>(a)] : style.control_untracked_colour;
+          l.points = {target.p, target.p + L * target.R.col(a)};
+          out.lines.push_back(std::move(l));
+        }
+      }
+      if (has_actual && has_target && (target.p - actual.p).norm() > style.control_error_min) {
+        Polyline l;
+        l.layer = Layer::kControl;
+        l.colour = style.control_error_colour;
+        l.points = {actual.p, target.p};
+        out.lines.push_back(std::move(l));
+      }
+    }
     const auto hull = convexHull(std::move(support));
     if (hull.size() >= 2) {
       Polyline l;
