@@ -156,6 +156,25 @@ void addMissingModels(const v1::WorldState& ws, render::SceneAssets& assets, std
   }
 }
 
+/// What a frame draws of `ws`: its scene with the hidden layers removed.
+render::RenderScene sceneOf(const v1::WorldState& ws, const render::SceneAssets& assets, const render::ViewConfig& view,
+                            const render::RenderLayers& layers) {
+  render::RenderScene s = render::buildScene(ws, assets, view.style);
+  render::applyLayers(s, layers);
+  return s;
+}
+
+/// `view` with its orbit camera's target on the followed mannequin (desktop views with `follow`, or `follow`
+/// given: the window's key F), shifted by the user's pan since the start (`orbit` − the view's own).
+render::ViewConfig followedView(const render::ViewConfig& view, const render::OrbitCamera& orbit, const v1::WorldState* ws,
+                                const std::string& follow) {
+  render::ViewConfig v = view;
+  v.orbit = orbit;
+  if (ws == nullptr || follow.empty() || view.type != render::ViewConfig::Type::kDesktop) return v;
+  v.orbit = render::followed(orbit, *ws, follow, (orbit.target - view.orbit.target).head<2>());
+  return v;
+}
+
 /// Every sim.world message of a recording, in log-time order.
 std::vector<v1::WorldState> readRecording(const std::string& path) {
   const recording::McapReader reader = recording::McapReader::open(path);
@@ -287,14 +306,17 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
   render::HeadlessContext ctx(w, h);
   render::Renderer renderer;
   spdlog::info("headless {}x{} on {}", w, h, render::Renderer::describeContext());
-  const render::Camera cam = view.camera(w, h);
+  render::RenderLayers layers = view.layers;
+  if (o.overlay) layers.overlay = true;
+  // the camera of a state: the view's, with a desktop `follow` its target on the followed mannequin
+  const auto cameraOf = [&](const v1::WorldState* ws) { return followedView(view, view.orbit, ws, view.follow).camera(w, h); };
   std::set<std::string> tried;
   long long written = 0;
   OverlayText overlay;
   const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index,
                         const v1::WorldState* ws, bool live) {
     renderer.draw(scene, camera, w, h, view.background);
-    if (o.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), w, h);
+    if (layers.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), w, h);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06zu.png", index);
     render::writePng((fs::path(o.out) / name).string(), ctx.read());
@@ -329,8 +351,9 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       const std::uint64_t step = *picked;
       const v1::WorldState* ws = live.stateAt(step);
       addMissingModels(*ws, assets, tried);
-      renderer.draw(render::buildScene(*ws, assets, view.style), live.camera(view, w, h), w, h, view.background);
-      if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+      renderer.draw(sceneOf(*ws, assets, view, layers), live.camera(followedView(view, view.orbit, ws, view.follow), w, h), w,
+                    h, view.background);
+      if (layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
       const render::Image img = ctx.read();
       barrier.arriveAndWait(step);
       // the swap: the frame goes out now
@@ -356,12 +379,15 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       const long long index = states++;
       if (index % o.every != 0) continue;
       addMissingModels(live.latest(), assets, tried);
-      emit(render::buildScene(live.latest(), assets, view.style), live.camera(view, w, h), static_cast<std::size_t>(index),
+      emit(sceneOf(live.latest(), assets, view, layers),
+           live.camera(followedView(view, view.orbit, &live.latest(), view.follow), w, h), static_cast<std::size_t>(index),
            &live.latest(), true);
     }
   } else if (o.from.empty()) {
     // neither a recording nor publishers: the static scene, once
-    emit(render::buildStaticScene(assets, view.style), cam, 0, nullptr, false);
+    render::RenderScene still = render::buildStaticScene(assets, view.style);
+    render::applyLayers(still, layers);
+    emit(still, cameraOf(nullptr), 0, nullptr, false);
   } else {
     const std::vector<v1::WorldState> states = readRecording(o.from);
     if (states.empty()) {
@@ -371,18 +397,41 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     for (std::size_t i = 0; i < states.size(); i += static_cast<std::size_t>(o.every)) {
       if (o.frames > 0 && written >= o.frames) break;
       addMissingModels(states[i], assets, tried);
-      emit(render::buildScene(states[i], assets, view.style), cam, i, &states[i], false);
+      emit(sceneOf(states[i], assets, view, layers), cameraOf(&states[i]), i, &states[i], false);
     }
   }
   std::printf("wrote %lld frames (%dx%d) to %s\n", written, w, h, o.out.c_str());
   return core::kExitOk;
 }
 
-struct Mouse {
+/// A window's input state (mouse: orbit, pan, zoom; keys: docs/render.md "Keys").
+struct Input {
   render::OrbitCamera* orbit = nullptr;
+  const render::ViewConfig* view = nullptr;
   double x = 0, y = 0;
   bool left = false, right = false;
+  render::RenderLayers layers;  // 1..7 toggle
+  std::string follow;           // F toggles between "" and the view's `follow` (or mannequin 0)
+  bool paused = false;          // P: the drawn state is frozen
 };
+
+void onKey(GLFWwindow* w, int key, int, int action, int) {
+  if (action != GLFW_PRESS) return;
+  auto* in = static_cast<Input*>(glfwGetWindowUserPointer(w));
+  if (key >= GLFW_KEY_1 && key < GLFW_KEY_1 + render::RenderLayers::kCount) {
+    const int i = key - GLFW_KEY_1;
+    in->layers.flag(i) = !in->layers.flag(i);
+    spdlog::info("layer {} {}", render::RenderLayers::names()[static_cast<std::size_t>(i)], in->layers.flag(i) ? "on" : "off");
+  } else if (key == GLFW_KEY_F && in->view->type == render::ViewConfig::Type::kDesktop) {
+    in->follow = in->follow.empty() ? (in->view->follow.empty() ? std::string("0") : in->view->follow) : std::string();
+    spdlog::info("follow {}", in->follow.empty() ? "off" : in->follow);
+  } else if (key == GLFW_KEY_P) {
+    in->paused = !in->paused;
+    spdlog::info("{}", in->paused ? "paused" : "running");
+  } else if (key == GLFW_KEY_R) {
+    *in->orbit = in->view->orbit;
+  }
+}
 
 int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets, NodeLink& link) {
   const char* x11 = std::getenv("DISPLAY");
@@ -425,28 +474,34 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
     render::Renderer renderer;
     spdlog::info("window {}x{} on {}", view.width, view.height, render::Renderer::describeContext());
     render::OrbitCamera orbit = view.orbit;
-    Mouse mouse{&orbit};
+    Input mouse;
+    mouse.orbit = &orbit;
+    mouse.view = &view;
+    mouse.layers = view.layers;
+    if (o.overlay) mouse.layers.overlay = true;
+    mouse.follow = view.follow;
     glfwSetWindowUserPointer(win, &mouse);
+    glfwSetKeyCallback(win, onKey);
     if (view.type == render::ViewConfig::Type::kDesktop) {
       glfwSetMouseButtonCallback(win, [](GLFWwindow* w, int button, int action, int) {
-        auto* m = static_cast<Mouse*>(glfwGetWindowUserPointer(w));
+        auto* m = static_cast<Input*>(glfwGetWindowUserPointer(w));
         if (button == GLFW_MOUSE_BUTTON_LEFT) m->left = action == GLFW_PRESS;
         if (button == GLFW_MOUSE_BUTTON_RIGHT) m->right = action == GLFW_PRESS;
       });
       glfwSetCursorPosCallback(win, [](GLFWwindow* w, double x, double y) {
-        auto* m = static_cast<Mouse*>(glfwGetWindowUserPointer(w));
+        auto* m = static_cast<Input*>(glfwGetWindowUserPointer(w));
         if (m->left) m->orbit->rotate(-0.01 * (x - m->x), 0.01 * (y - m->y));
         if (m->right) m->orbit->pan(-0.002 * m->orbit->distance * (x - m->x), 0.002 * m->orbit->distance * (y - m->y));
         m->x = x;
         m->y = y;
       });
       glfwSetScrollCallback(win, [](GLFWwindow* w, double, double dy) {
-        static_cast<Mouse*>(glfwGetWindowUserPointer(w))->orbit->zoom(std::pow(0.9, dy));
+        static_cast<Input*>(glfwGetWindowUserPointer(w))->orbit->zoom(std::pow(0.9, dy));
       });
     }
     const auto start = std::chrono::steady_clock::now();
     const auto& stop = core::installStopSignals();
-    const render::RenderScene still = render::buildStaticScene(assets, view.style);
+    const render::RenderScene still_all = render::buildStaticScene(assets, view.style);
     long long swapped = 0;
     OverlayText overlay;
     if (view.sync) {
@@ -478,11 +533,10 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         const v1::WorldState* ws = live->stateAt(*picked);
         int w = 0, h = 0;
         glfwGetFramebufferSize(win, &w, &h);
-        render::ViewConfig v = view;
-        v.orbit = orbit;
         addMissingModels(*ws, assets, tried);
-        renderer.draw(render::buildScene(*ws, assets, view.style), live->camera(v, w, h), w, h, view.background);
-        if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+        renderer.draw(sceneOf(*ws, assets, view, mouse.layers), live->camera(followedView(view, orbit, ws, mouse.follow), w, h),
+                      w, h, view.background);
+        if (mouse.layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
         glFinish();
         barrier.arriveAndWait(*picked);
         glfwSwapBuffers(win);
@@ -492,32 +546,48 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         last = *picked;
       }
     }
+    std::optional<v1::WorldState> held;  // P: the state frozen on the screen
+    bool held_live = false;
     while (!view.sync && !glfwWindowShouldClose(win) && !stop.load()) {
       int w = 0, h = 0;
       glfwGetFramebufferSize(win, &w, &h);
-      render::ViewConfig v = view;
-      v.orbit = orbit;
       if (live) live->poll(std::chrono::microseconds(0));
-      const render::Camera cam = live ? live->camera(v, w, h) : v.camera(w, h);
+      // the state to draw: the newest live one, or the recording's at its sim time (looping); none: the scene
+      const v1::WorldState* ws = nullptr;
+      bool is_live = false;
       if (live) {
-        if (live->received() == 0) {
-          renderer.draw(still, cam, w, h, view.background);
-        } else {
-          addMissingModels(live->latest(), assets, tried);
-          renderer.draw(render::buildScene(live->latest(), assets, view.style), cam, w, h, view.background);
-          if (o.overlay) OverlayText::draw(renderer, overlay.line(live->latest(), true), w, h);
+        if (live->received() > 0) {
+          ws = &live->latest();
+          is_live = true;
         }
-      } else if (states.empty()) {
-        renderer.draw(still, cam, w, h, view.background);
-      } else {  // play at the recording's sim time, looping
+      } else if (!states.empty()) {
         const double span = std::max(1e-9, states.back().sim_time() - states.front().sim_time());
         const double t = std::fmod(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), span) +
                          states.front().sim_time();
         std::size_t i = 0;
         while (i + 1 < states.size() && states[i + 1].sim_time() <= t) ++i;
-        addMissingModels(states[i], assets, tried);
-        renderer.draw(render::buildScene(states[i], assets, view.style), cam, w, h, view.background);
-        if (o.overlay) OverlayText::draw(renderer, overlay.line(states[i], false), w, h);
+        ws = &states[i];
+      }
+      if (mouse.paused && ws != nullptr) {
+        if (!held) {
+          held = *ws;
+          held_live = is_live;
+        }
+        ws = &*held;
+        is_live = held_live;
+      } else if (!mouse.paused) {
+        held.reset();
+      }
+      const render::ViewConfig v = followedView(view, orbit, ws, mouse.follow);
+      const render::Camera cam = live ? live->camera(v, w, h) : v.camera(w, h);
+      if (ws == nullptr) {
+        render::RenderScene still = still_all;
+        render::applyLayers(still, mouse.layers);
+        renderer.draw(still, cam, w, h, view.background);
+      } else {
+        addMissingModels(*ws, assets, tried);
+        renderer.draw(sceneOf(*ws, assets, view, mouse.layers), cam, w, h, view.background);
+        if (mouse.layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, is_live), w, h);
       }
       glfwSwapBuffers(win);
       glfwPollEvents();

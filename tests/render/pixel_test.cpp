@@ -205,6 +205,84 @@ TEST_F(Headless, AControlFrameErrorLineRunsBetweenThePoseAndTheTargetAndVanishes
   EXPECT_GT(axes_same, 20);
 }
 
+TEST_F(Scenes, ALayerSwitchedOffLeavesNoPixelOfItsColour) {
+  testing::addContact(*ms_, Vec3(0.0, 0.45, 1.2), Vec3::UnitY(), Vec3(0, 250, 0), "alice/hand_r", "wall");
+  testing::addControlFrame(*ms_, "hand_l", SE3(Eigen::Matrix3d::Identity(), Vec3(0, -0.6, 1.0)),
+                           SE3(Eigen::Matrix3d::Identity(), Vec3(0, -0.9, 1.1)));
+  const auto countOf = [&](const Image& img, bool (*cls)(const std::array<std::uint8_t, 3>&)) {
+    int n = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) n += cls(img.at(x, y)) ? 1 : 0;
+    return n;
+  };
+  const RenderScene all = buildScene(ws_, assets_);
+  const Image full = render(all, cam_);
+  ASSERT_GT(countOf(full, isMannequinBlue), 1000);
+  ASSERT_GT(countOf(full, isForce), 20);
+  ASSERT_GT(countOf(full, isControlError), 10);
+  // the control frame's axes are red, green and blue (the usual convention), hues the force and mannequin
+  // classes also match: those two cases hide the control frames too, and look for the error line's magenta
+  struct Case {
+    RenderLayers layers;
+    bool (*cls)(const std::array<std::uint8_t, 3>&);
+    const char* what;
+  };
+  RenderLayers no_mannequins, no_contacts, no_control;
+  no_mannequins.mannequins = no_mannequins.control_frames = false;
+  no_contacts.contacts = no_contacts.control_frames = false;
+  no_control.control_frames = false;
+  for (const Case& c : {Case{no_mannequins, isMannequinBlue, "mannequins"}, Case{no_contacts, isForce, "contacts"},
+                        Case{no_control, isControlError, "control_frames"}}) {
+    RenderScene s = all;
+    applyLayers(s, c.layers);
+    const Image img = render(s, cam_);
+    EXPECT_EQ(countOf(img, c.cls), 0) << c.what << " off";
+    // the layers still on are still drawn
+    if (c.layers.mannequins) {
+      EXPECT_GT(countOf(img, isMannequinBlue), 1000) << c.what << " off";
+    }
+    if (c.layers.contacts) {
+      EXPECT_GT(countOf(img, isForce), 20) << c.what << " off";
+    }
+  }
+  // and the colour classes do not hide one another: switching off every layer but one leaves its colour
+  RenderLayers only_control;
+  only_control.mannequins = only_control.scene = only_control.objects = only_control.contacts = only_control.balance = false;
+  RenderScene s = all;
+  applyLayers(s, only_control);
+  EXPECT_EQ(s.count(Layer::kControl), 3u);
+  EXPECT_EQ(s.solids.size(), 3u);
+  EXPECT_GT(countOf(render(s, cam_), isControlError), 10);
+}
+
+TEST_F(Scenes, AFollowingCameraKeepsAMannequinWalking2MetresNearTheImageCentre) {
+  // the mannequin walks 2 m along +y (image right from this camera): its blue pixels' mean column
+  const auto meanColumn = [&](const Image& img) {
+    double sum = 0;
+    int n = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x)
+        if (isMannequinBlue(img.at(x, y))) { sum += x + 0.5; ++n; }
+    return std::make_pair(n, n ? sum / n : -1.0);
+  };
+  const math::VectorX q0 = skeleton::standingConfiguration(*model_);
+  double still_last = 0;
+  int still_n = 0;
+  for (int k = 0; k <= 4; ++k) {
+    math::VectorX q = q0;
+    q[1] += 0.5 * k;  // root position y
+    v1::WorldState ws;
+    testing::addMannequin(ws, *model_, q, "alice");
+    const OrbitCamera follow = followed(orbit_, ws, "alice");
+    const auto [n, x] = meanColumn(render(buildScene(ws, assets_), follow.camera(static_cast<double>(kW) / kH)));
+    ASSERT_GT(n, 1000) << "step " << k;
+    EXPECT_NEAR(x, 0.5 * kW, 0.05 * kW) << "step " << k;  // the figure stays centred (its pelvis is the target)
+    std::tie(still_n, still_last) = meanColumn(render(buildScene(ws, assets_), cam_));
+  }
+  // without following, the same walk takes it out of the picture (at least most of it)
+  EXPECT_TRUE(still_n < 300 || still_last > 0.85 * kW) << still_n << " px at column " << still_last;
+}
+
 TEST_F(Scenes, TwoWallViewsOfOneFrameAgreeAtTheirSharedEdge) {
   const ViewConfig front = loadView(testing::sourcePath("configs/views/wall_front.yaml"));
   const ViewConfig right = loadView(testing::sourcePath("configs/views/wall_right.yaml"));

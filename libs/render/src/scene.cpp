@@ -89,6 +89,42 @@ std::size_t RenderScene::countTagged(const std::string& prefix) const {
       solids.begin(), solids.end(), [&](const Primitive& p) { return p.tag.rfind(prefix, 0) == 0; }));
 }
 
+const std::array<const char*, RenderLayers::kCount>& RenderLayers::names() {
+  static const std::array<const char*, kCount> n{"mannequins", "scene", "objects", "contacts", "balance",
+                                                 "control_frames", "overlay"};
+  return n;
+}
+
+bool& RenderLayers::flag(int i) {
+  switch (i) {
+    case 0: return mannequins;
+    case 1: return scene;
+    case 2: return objects;
+    case 3: return contacts;
+    case 4: return balance;
+    case 5: return control_frames;
+    default: return overlay;
+  }
+}
+
+bool RenderLayers::shows(Layer layer) const {
+  switch (layer) {
+    case Layer::kScene: return scene;
+    case Layer::kObject: return objects;
+    case Layer::kMannequin: return mannequins;
+    case Layer::kContact:
+    case Layer::kForce: return contacts;
+    case Layer::kBalance: return balance;
+    case Layer::kControl: return control_frames;
+  }
+  return true;
+}
+
+void applyLayers(RenderScene& scene, const RenderLayers& layers) {
+  std::erase_if(scene.solids, [&](const Primitive& p) { return !layers.shows(p.layer); });
+  std::erase_if(scene.lines, [&](const Polyline& l) { return !layers.shows(l.layer); });
+}
+
 Colour forceColour(double newtons, const Style& style) {
   const double t = style.force_full > 0 ? std::clamp(newtons / style.force_full, 0.0, 1.0) : 1.0;
   // yellow (1, 0.9, 0.1) → red (0.95, 0.1, 0.05)

@@ -1,5 +1,6 @@
 #include "mannequin/render/view.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -8,6 +9,7 @@
 
 #include "mannequin/core/config.hpp"
 #include "mannequin/v1/mocap.pb.h"
+#include "mannequin/v1/world.pb.h"
 
 namespace mannequin::render {
 
@@ -18,7 +20,7 @@ ViewConfig fromNode(const core::ConfigNode& root) {
   ViewConfig v;
   v.source = root.file();
   root.allowOnly({"name", "type", "size", "background", "camera", "wall", "head", "head_body", "head_offset", "near",
-                  "far", "style", "sync", "sync_timeout"});
+                  "far", "style", "sync", "sync_timeout", "layers", "follow"});
   if (auto y = root.find("sync")) v.sync = y->boolean();
   v.sync_timeout = root.getIn("sync_timeout", v.sync_timeout, 0.01, 60.0);
   v.name = root.get("name", v.name);
@@ -42,6 +44,18 @@ ViewConfig fromNode(const core::ConfigNode& root) {
     s->allowOnly({"force_scale", "force_full"});
     if (auto f = s->find("force_scale")) v.style.force_scale = f->positive();
     if (auto f = s->find("force_full")) v.style.force_full = f->positive();
+  }
+  if (auto l = root.find("layers")) {
+    if (!l->isMap()) l->fail("expected a map {layer: true|false}");
+    const auto& names = RenderLayers::names();
+    l->allowOnly(std::vector<std::string>(names.begin(), names.end()));
+    for (int i = 0; i < RenderLayers::kCount; ++i)
+      if (auto f = l->find(names[static_cast<std::size_t>(i)])) v.layers.flag(i) = f->boolean();
+  }
+  if (auto f = root.find("follow")) {
+    if (v.type != ViewConfig::Type::kDesktop) f->fail("only a desktop view follows a mannequin (type: desktop)");
+    v.follow = f->str();
+    if (v.follow.empty()) f->fail("expected a mannequin name or index");
   }
   if (v.type == ViewConfig::Type::kDesktop) {
     for (const char* k : {"wall", "head", "head_body", "head_offset", "near", "far"})
@@ -102,6 +116,39 @@ std::optional<Vec3> trackedHead(const v1::MocapFrame& frame, const ViewConfig& v
     return eye;
   }
   return std::nullopt;
+}
+
+std::optional<Vec3> followPoint(const v1::WorldState& state, const std::string& follow) {
+  if (follow.empty()) return std::nullopt;
+  const v1::MannequinState* m = nullptr;
+  for (const v1::MannequinState& c : state.mannequins())
+    if (c.name() == follow) {
+      m = &c;
+      break;
+    }
+  if (m == nullptr && std::all_of(follow.begin(), follow.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+      follow.size() < 9) {
+    const int i = std::stoi(follow);
+    if (i < state.mannequins_size()) m = &state.mannequins(i);
+  }
+  if (m == nullptr) return std::nullopt;
+  const auto vec = [](const v1::Vec3& p) { return Vec3(p.x(), p.y(), p.z()); };
+  for (const v1::NamedPose& s : m->segments())
+    if (s.name() == "pelvis") return vec(s.pose().position());
+  if (m->segments_size() > 0) return vec(m->segments(0).pose().position());
+  if (m->has_com()) return vec(m->com());
+  return std::nullopt;
+}
+
+OrbitCamera followed(const OrbitCamera& orbit, const v1::WorldState& state, const std::string& follow,
+                     const Eigen::Vector2d& offset) {
+  OrbitCamera out = orbit;
+  const auto p = followPoint(state, follow);
+  if (p && p->allFinite()) {
+    out.target.x() = p->x() + offset.x();
+    out.target.y() = p->y() + offset.y();
+  }
+  return out;
 }
 
 ViewConfig parseView(const std::string& yaml_text, const std::string& source) {

@@ -129,6 +129,29 @@ struct RenderScene {
   std::size_t countTagged(const std::string& prefix) const;
 };
 
+/// Which layers a view draws (view file `layers:`, window keys 1..7; docs/render.md). The overlay is the
+/// text line (Renderer::drawOverlay), drawn by the node, not part of the RenderScene.
+struct RenderLayers {
+  bool mannequins = true;      ///< kMannequin: segment capsules
+  bool scene = true;           ///< kScene: static bodies (floor, table, ...)
+  bool objects = true;         ///< kObject: movable bodies
+  bool contacts = true;        ///< kContact and kForce: contact points and force arrows
+  bool balance = true;         ///< kBalance: CoM and support polygon
+  bool control_frames = true;  ///< kControl: control frames, targets and error lines
+  bool overlay = false;        ///< the text overlay (also on with --overlay)
+
+  static constexpr int kCount = 7;
+  /// The view-file keys, in key order (key 1 toggles names()[0], ...).
+  static const std::array<const char*, kCount>& names();
+  /// The flag of names()[i], i in [0, kCount).
+  bool& flag(int i);
+  bool flag(int i) const { return const_cast<RenderLayers*>(this)->flag(i); }
+  bool shows(Layer layer) const;
+};
+
+/// Removes the solids and lines of the layers `layers` hides.
+void applyLayers(RenderScene& scene, const RenderLayers& layers);
+
 /// Colour of a force arrow of norm `newtons` (yellow → red over [0, style.force_full]).
 Colour forceColour(double newtons, const Style& style);
 
