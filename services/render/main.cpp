@@ -97,17 +97,14 @@ class NodeLink {
   std::unique_ptr<transport::HealthReporter> health_;
 };
 
-/// The overlay's text line: the sim.world step and time; live also the render fps (frames drawn per
-/// second, smoothed) and the sim lateness (now − the state's send time, ms). Recordings show neither, so
-/// their frames stay deterministic.
+/// The overlay's lines (render::overlayLines): the sim.world step and time; live also the render fps (frames
+/// drawn per second, smoothed) and the lateness (now − the state's send time, ms); the sim's lag behind mocap,
+/// the stale-contact flag and the scenario line. Recordings show no fps nor lateness, so their frames stay
+/// deterministic.
 class OverlayText {
  public:
-  std::string line(const v1::WorldState& ws, bool live) {
-    char buf[160];
-    if (!live) {
-      std::snprintf(buf, sizeof buf, "FRAME %llu  T %.3f S", static_cast<unsigned long long>(ws.step()), ws.sim_time());
-      return buf;
-    }
+  std::vector<render::OverlayLine> line(const v1::WorldState& ws, bool live) {
+    if (!live) return render::overlayLines(ws, nullptr);
     const auto now = std::chrono::steady_clock::now();
     if (last_) {
       const double dt = std::chrono::duration<double>(now - *last_).count();
@@ -115,14 +112,11 @@ class OverlayText {
     }
     last_ = now;
     const std::int64_t sent = ws.header().send_time_ns();
-    const double late_ms = sent > 0 ? static_cast<double>(core::wallNs() - sent) * 1e-6 : 0.0;
-    std::snprintf(buf, sizeof buf, "FRAME %llu  FPS %.1f  LATE %.1f MS", static_cast<unsigned long long>(ws.step()), fps_,
-                  late_ms);
-    return buf;
+    const render::OverlayLive stats{fps_, sent > 0 ? static_cast<double>(core::wallNs() - sent) * 1e-6 : 0.0};
+    return render::overlayLines(ws, &stats);
   }
-  static void draw(render::Renderer& r, const std::string& text, int w, int h) {
-    const float height = std::max(8.0f, static_cast<float>(h) / 40.0f);
-    r.drawOverlay(render::strokeText(text, height, height, height), w, h, {1.0f, 1.0f, 1.0f, 1.0f});
+  static void draw(render::Renderer& r, const std::vector<render::OverlayLine>& lines, int w, int h) {
+    for (const auto& [segments, colour] : render::layoutOverlay(lines, h)) r.drawOverlay(segments, w, h, colour);
   }
 
  private:

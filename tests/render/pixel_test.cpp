@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <tuple>
 
 #include "fixtures.hpp"
 #include "mannequin/render/renderer.hpp"
@@ -415,6 +416,92 @@ TEST_F(OverlayPixels, TextIsDrawnInsideItsBoxAndTheChangedDigitChangesOnlyItsCel
       }
   EXPECT_GT(changed, 5);
   EXPECT_EQ(changed_elsewhere, 0);
+}
+
+}  // namespace
+}  // namespace mannequin::render
+
+namespace mannequin::render {
+namespace {
+
+TEST(OverlayText, StatusStaleContactsAndScenarioLines) {
+  v1::WorldState ws;
+  ws.set_step(1200);
+  ws.set_sim_time(1.2);
+  auto lines = overlayLines(ws, nullptr);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0].text, "FRAME 1200  T 1.200 S");
+  const OverlayLive live{59.5, 12.25};
+  EXPECT_EQ(overlayLines(ws, &live)[0].text, "FRAME 1200  FPS 59.5  LATE 12.2 MS");
+  // the sim's lag behind mocap needs both send times
+  ws.mutable_header()->set_send_time_ns(5'000'000'000);
+  EXPECT_EQ(overlayLines(ws, nullptr)[0].text, "FRAME 1200  T 1.200 S");
+  ws.mutable_mocap()->set_send_time_ns(4'996'500'000);
+  EXPECT_EQ(overlayLines(ws, nullptr)[0].text, "FRAME 1200  T 1.200 S  SIM LAG 3.5 MS");
+  // stale contacts: the warning line, in the warning colour
+  ws.set_contacts_stale(true);
+  ws.set_contacts_step(1197);
+  const OverlayStyle style;
+  lines = overlayLines(ws, nullptr, style);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[1].text, "CONTACTS STALE  3 STEPS OLD");
+  EXPECT_EQ(lines[1].colour, style.warning);
+  // scenario: mechanisms, frames not free by mode, occluded mocap-driven frames
+  ws.set_contacts_stale(false);
+  ws.add_active_mechanisms("door_hinge");
+  v1::MannequinState* m = ws.add_mannequins();
+  m->set_name("operator");
+  for (const auto& [frame, mode, body, tracked] :
+       {std::tuple{"hand_l", "constrained", "lhand", true}, std::tuple{"hand_r", "free", "rhand", false},
+        std::tuple{"foot_l", "autonomous", "", false}, std::tuple{"foot_r", "constrained", "rfoot", true}}) {
+    v1::ControlFrameState* cf = m->add_control_frames();
+    cf->set_frame(frame);
+    cf->set_mode(mode);
+    cf->set_body(body);
+    cf->set_tracked(tracked);
+  }
+  lines = overlayLines(ws, nullptr, style);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[1].text, "MECHANISMS DOOR_HINGE  AUTONOMOUS FOOT_L  CONSTRAINED HAND_L FOOT_R  OCCLUDED HAND_R");
+  EXPECT_EQ(lines[1].colour, style.scenario);
+  ws.add_mannequins()->set_name("bob");  // several mannequins: frames carry their mannequin's name
+  EXPECT_NE(overlayLines(ws, nullptr)[1].text.find("CONSTRAINED OPERATOR/HAND_L OPERATOR/FOOT_R"), std::string::npos);
+  for (const char c : std::string("_,")) EXPECT_TRUE(hasGlyph(c)) << c;
+}
+
+TEST_F(OverlayPixels, TheStaleContactFlagIsDrawnInTheWarningColourOnlyWhenContactsAreStale) {
+  // a 200 × 60 image: capital height 8 px, line 2 at rows 22..30
+  const auto draw = [&](const v1::WorldState& ws) {
+    ViewConfig view;
+    renderer_->draw(RenderScene{}, view.camera(kW, kH), kW, kH, {0.1f, 0.1f, 0.1f});
+    for (const auto& [segments, colour] : layoutOverlay(overlayLines(ws, nullptr), kH))
+      renderer_->drawOverlay(segments, kW, kH, colour);
+    return ctx_->read();
+  };
+  const auto orange = [](const std::array<std::uint8_t, 3>& c) { return c[0] > 200 && c[1] > 80 && c[1] < 150 && c[2] < 60; };
+  v1::WorldState ws;
+  ws.set_step(42);
+  ws.set_contacts_step(40);
+  const Image fresh = draw(ws);
+  ws.set_contacts_stale(true);
+  const Image stale = draw(ws);
+  int orange_fresh = 0, orange_stale = 0, orange_outside = 0, lit_below_fresh = 0;
+  const float h = 8.0f, top = h + 1.75f * h;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      orange_fresh += orange(fresh.at(x, y)) ? 1 : 0;
+      if (y > top + h + 1 && fresh.at(x, y) != fresh.at(kW - 1, kH - 1)) ++lit_below_fresh;
+      if (!orange(stale.at(x, y))) continue;
+      ++orange_stale;
+      if (y < top - 1 || y > top + h + 1) ++orange_outside;
+    }
+  EXPECT_EQ(orange_fresh, 0);
+  EXPECT_EQ(lit_below_fresh, 0);  // no second line at all
+  EXPECT_EQ(orange_outside, 0);   // the flag is on its line
+  EXPECT_GE(orange_stale, 10 * 8);  // "CONTACTS STALE": a dozen glyphs of at least one 8 px stroke
+  // the first line is the same in both
+  for (int y = 0; y < static_cast<int>(top) - 1; ++y)
+    for (int x = 0; x < kW; ++x) ASSERT_EQ(fresh.at(x, y), stale.at(x, y)) << x << "," << y;
 }
 
 }  // namespace
