@@ -115,8 +115,11 @@ class OverlayText {
     const render::OverlayLive stats{fps_, sent > 0 ? static_cast<double>(core::wallNs() - sent) * 1e-6 : 0.0};
     return render::overlayLines(ws, &stats);
   }
-  static void draw(render::Renderer& r, const std::vector<render::OverlayLine>& lines, int w, int h) {
-    for (const auto& [segments, colour] : render::layoutOverlay(lines, h)) r.drawOverlay(segments, w, h, colour);
+  /// In every eye's part of the image (a stereo wall: the same text in both halves, on the screen plane).
+  static void draw(render::Renderer& r, const std::vector<render::OverlayLine>& lines,
+                   const std::vector<render::EyeView>& eyes, int h) {
+    for (const auto& [segments, colour] : render::layoutOverlay(lines, h))
+      for (const render::EyeView& e : eyes) r.drawOverlay(segments, e.x, e.width, h, colour);
   }
 
  private:
@@ -214,17 +217,17 @@ class LiveWorld {
         if (const auto h = render::trackedHead(f, view)) head_ = h;
       });
   }
-  /// The camera of `view` with the tracked head when there is one; a head that left the room (behind the
-  /// wall) keeps the last usable camera.
-  const render::Camera& camera(const render::ViewConfig& view, int w, int h) {
+  /// The camera(s) of `view` (ViewConfig::eyes: one, or a stereo wall's two) with the tracked head when
+  /// there is one; a head that left the room (an eye behind the wall) keeps the last usable cameras.
+  const std::vector<render::EyeView>& eyes(const render::ViewConfig& view, int w, int h) {
     render::ViewConfig v = view;
     if (head_) v.head = *head_;
     try {
-      camera_ = v.camera(w, h);
+      eyes_ = v.eyes(w, h);
     } catch (const std::invalid_argument& e) {
-      if (!camera_) camera_ = view.camera(w, h);
+      if (eyes_.empty() || eyes_.back().x + eyes_.back().width != w) eyes_ = view.eyes(w, h);
     }
-    return *camera_;
+    return eyes_;
   }
   /// Waits up to `timeout` for traffic; true when a newer state than the last call's arrived.
   bool poll(std::chrono::microseconds timeout) {
@@ -254,7 +257,7 @@ class LiveWorld {
   v1::WorldState latest_;
   long long received_ = 0, seen_ = 0;
   std::optional<render::Vec3> head_;
-  std::optional<render::Camera> camera_;
+  std::vector<render::EyeView> eyes_;
 };
 
 /// Synchronised nodes: the step to draw next (the leader's newest state, or as a follower the leader's
@@ -303,14 +306,14 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
   render::RenderLayers layers = view.layers;
   if (o.overlay) layers.overlay = true;
   // the camera of a state: the view's, with a desktop `follow` its target on the followed mannequin
-  const auto cameraOf = [&](const v1::WorldState* ws) { return followedView(view, view.orbit, ws, view.follow).camera(w, h); };
+  const auto cameraOf = [&](const v1::WorldState* ws) { return followedView(view, view.orbit, ws, view.follow).eyes(w, h); };
   std::set<std::string> tried;
   long long written = 0;
   OverlayText overlay;
-  const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index,
+  const auto emit = [&](const render::RenderScene& scene, const std::vector<render::EyeView>& eyes, std::size_t index,
                         const v1::WorldState* ws, bool live) {
-    renderer.draw(scene, camera, w, h, view.background);
-    if (layers.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), w, h);
+    renderer.draw(scene, eyes, h, view.background);
+    if (layers.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), eyes, h);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06zu.png", index);
     render::writePng((fs::path(o.out) / name).string(), ctx.read());
@@ -345,9 +348,9 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       const std::uint64_t step = *picked;
       const v1::WorldState* ws = live.stateAt(step);
       addMissingModels(*ws, assets, tried);
-      renderer.draw(sceneOf(*ws, assets, view, layers), live.camera(followedView(view, view.orbit, ws, view.follow), w, h), w,
-                    h, view.background);
-      if (layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+      const auto& eyes = live.eyes(followedView(view, view.orbit, ws, view.follow), w, h);
+      renderer.draw(sceneOf(*ws, assets, view, layers), eyes, h, view.background);
+      if (layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), eyes, h);
       const render::Image img = ctx.read();
       barrier.arriveAndWait(step);
       // the swap: the frame goes out now
@@ -374,7 +377,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       if (index % o.every != 0) continue;
       addMissingModels(live.latest(), assets, tried);
       emit(sceneOf(live.latest(), assets, view, layers),
-           live.camera(followedView(view, view.orbit, &live.latest(), view.follow), w, h), static_cast<std::size_t>(index),
+           live.eyes(followedView(view, view.orbit, &live.latest(), view.follow), w, h), static_cast<std::size_t>(index),
            &live.latest(), true);
     }
   } else if (o.from.empty()) {
@@ -528,9 +531,9 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         int w = 0, h = 0;
         glfwGetFramebufferSize(win, &w, &h);
         addMissingModels(*ws, assets, tried);
-        renderer.draw(sceneOf(*ws, assets, view, mouse.layers), live->camera(followedView(view, orbit, ws, mouse.follow), w, h),
-                      w, h, view.background);
-        if (mouse.layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+        const auto& eyes = live->eyes(followedView(view, orbit, ws, mouse.follow), w, h);
+        renderer.draw(sceneOf(*ws, assets, view, mouse.layers), eyes, h, view.background);
+        if (mouse.layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), eyes, h);
         glFinish();
         barrier.arriveAndWait(*picked);
         glfwSwapBuffers(win);
@@ -573,15 +576,15 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         held.reset();
       }
       const render::ViewConfig v = followedView(view, orbit, ws, mouse.follow);
-      const render::Camera cam = live ? live->camera(v, w, h) : v.camera(w, h);
+      const std::vector<render::EyeView> cam = live ? live->eyes(v, w, h) : v.eyes(w, h);
       if (ws == nullptr) {
         render::RenderScene still = still_all;
         render::applyLayers(still, mouse.layers);
-        renderer.draw(still, cam, w, h, view.background);
+        renderer.draw(still, cam, h, view.background);
       } else {
         addMissingModels(*ws, assets, tried);
-        renderer.draw(sceneOf(*ws, assets, view, mouse.layers), cam, w, h, view.background);
-        if (mouse.layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, is_live), w, h);
+        renderer.draw(sceneOf(*ws, assets, view, mouse.layers), cam, h, view.background);
+        if (mouse.layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, is_live), cam, h);
       }
       glfwSwapBuffers(win);
       glfwPollEvents();

@@ -284,6 +284,63 @@ TEST_F(Scenes, AFollowingCameraKeepsAMannequinWalking2MetresNearTheImageCentre) 
   EXPECT_TRUE(still_n < 300 || still_last > 0.85 * kW) << still_n << " px at column " << still_last;
 }
 
+TEST_F(Headless, StereoSideBySideHalvesShowCrossedParallaxInFrontOfTheWallAndUncrossedBehindIt) {
+  ViewConfig view = parseView(
+      "type: wall\nwall: {lower_left: [1.5, 1.5, 0], lower_right: [1.5, -1.5, 0], upper_left: [1.5, 1.5, 3]}\n"
+      "head: [0, 0, 1.5]\nstereo: {eye_separation: 0.2, mode: side_by_side}\n",
+      "stereo.yaml");
+  const auto eyes = view.eyes(kW, kH);
+  ASSERT_EQ(eyes.size(), 2u);
+  // mean column (within its half) of the blue pixels of each half
+  const auto columns = [&](const Image& img) {
+    std::array<double, 2> sum{0, 0};
+    std::array<int, 2> n{0, 0};
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x)
+        if (isMannequinBlue(img.at(x, y))) {
+          const std::size_t half = x < eyes[1].x ? 0 : 1;
+          sum[half] += x + 0.5 - eyes[half].x;
+          ++n[half];
+        }
+    EXPECT_GT(n[0], 4);
+    EXPECT_GT(n[1], 4);
+    return std::array<double, 2>{sum[0] / std::max(1, n[0]), sum[1] / std::max(1, n[1])};
+  };
+  const auto ball = [](const Vec3& p, double r) {
+    RenderScene s;
+    Primitive b;
+    b.kind = Kind::kSphere;
+    b.radius = r;
+    b.pose.p = p;
+    b.colour = Style{}.mannequin_colours[0];
+    s.solids.push_back(b);
+    return s;
+  };
+  struct Case {
+    Vec3 p;
+    double r;
+    int sign;  // of (left column − right column): + crossed (in front of the wall), − uncrossed (behind)
+  };
+  for (const Case& c : {Case{Vec3(0.6, 0, 1.5), 0.03, +1}, Case{Vec3(4.5, 0, 1.5), 0.15, -1}}) {
+    ctx_->makeCurrent();
+    renderer_->draw(ball(c.p, c.r), eyes, kH, {0.11f, 0.12f, 0.14f});
+    const Image img = ctx_->read();
+    const auto seen = columns(img);
+    const double expected_left = eyes[0].camera.pixel(c.p, eyes[0].width, kH).x();
+    const double expected_right = eyes[1].camera.pixel(c.p, eyes[1].width, kH).x();
+    const double parallax = expected_left - expected_right;
+    EXPECT_GT(c.sign * parallax, 5.0) << c.p.transpose();  // the case is meaningful: several pixels
+    EXPECT_NEAR(seen[0], expected_left, 1.0) << c.p.transpose();
+    EXPECT_NEAR(seen[1], expected_right, 1.0) << c.p.transpose();
+    EXPECT_GT(c.sign * (seen[0] - seen[1]), 0.7 * std::abs(parallax)) << c.p.transpose();
+  }
+  // on the wall plane there is no parallax
+  ctx_->makeCurrent();
+  renderer_->draw(ball(Vec3(1.5, 0, 1.5), 0.05), eyes, kH, {0.11f, 0.12f, 0.14f});
+  const auto on = columns(ctx_->read());
+  EXPECT_NEAR(on[0], on[1], 1.0);
+}
+
 TEST_F(Scenes, TwoWallViewsOfOneFrameAgreeAtTheirSharedEdge) {
   const ViewConfig front = loadView(testing::sourcePath("configs/views/wall_front.yaml"));
   const ViewConfig right = loadView(testing::sourcePath("configs/views/wall_right.yaml"));

@@ -183,3 +183,50 @@ TEST(ViewConfig, FollowIsADesktopKeyNamingAMannequinByNameOrIndex) {
 
 }  // namespace
 }  // namespace mannequin::render
+
+namespace mannequin::render {
+namespace {
+
+const char* kStereoWall =
+    "type: wall\nwall: {lower_left: [1.5, 1.5, 0], lower_right: [1.5, -1.5, 0], upper_left: [1.5, 1.5, 3]}\n"
+    "head: [0, 0.1, 1.7]\n";
+
+TEST(ViewConfig, StereoWallHasTwoEyesAlongTheWallsRightAxis) {
+  const ViewConfig mono = parseView(kStereoWall, "v.yaml");
+  EXPECT_FALSE(mono.stereo.enabled);
+  ASSERT_EQ(mono.eyes(640, 320).size(), 1u);
+  EXPECT_TRUE(mono.eyes(640, 320)[0].camera.eye.isApprox(mono.head));
+  EXPECT_EQ(mono.eyes(640, 320)[0].width, 640);
+  const ViewConfig v = parseView(std::string(kStereoWall) + "stereo: {eye_separation: 0.07, mode: side_by_side}\n", "v.yaml");
+  ASSERT_TRUE(v.stereo.enabled);
+  EXPECT_DOUBLE_EQ(v.stereo.eye_separation, 0.07);
+  const auto eyes = v.eyes(641, 320);
+  ASSERT_EQ(eyes.size(), 2u);
+  // the wall's right axis is −y (lower_left → lower_right): the left eye is at +y
+  EXPECT_TRUE(eyes[0].camera.eye.isApprox(v.head + Vec3(0, 0.035, 0), 1e-12));
+  EXPECT_TRUE(eyes[1].camera.eye.isApprox(v.head - Vec3(0, 0.035, 0), 1e-12));
+  EXPECT_EQ(eyes[0].x, 0);
+  EXPECT_EQ(eyes[0].width, 320);
+  EXPECT_EQ(eyes[1].x, 320);
+  EXPECT_EQ(eyes[1].width, 321);
+  // each eye's frustum still maps the wall's corners onto its half's corners
+  for (const EyeView& e : eyes) {
+    const Eigen::Vector2d ll = e.camera.pixel(v.wall.lower_left, e.width, 320);
+    EXPECT_NEAR(ll.x(), 0.0, 1e-9);
+    EXPECT_NEAR(ll.y(), 320.0, 1e-9);
+    EXPECT_NEAR(e.camera.pixel(v.wall.lower_right, e.width, 320).x(), e.width, 1e-9);
+  }
+  // errors: FILE:LINE and key
+  const auto err = [](const std::string& extra) { return errorOf(std::string(kStereoWall) + extra); };
+  EXPECT_NE(err("stereo: {eye_separation: 0.07, mode: anaglyph}\n").find("v.yaml:4"), std::string::npos);
+  EXPECT_NE(err("stereo: {eye_separation: 0.07, mode: anaglyph}\n").find("side_by_side"), std::string::npos);
+  EXPECT_NE(err("stereo: {eye_sep: 0.07}\n").find("eye_sep"), std::string::npos);
+  EXPECT_NE(err("stereo: {eye_separation: -0.07}\n").find("stereo.eye_separation"), std::string::npos);
+  EXPECT_NE(err("stereo: {eye_separation: 2}\n").find("(0, 0.5]"), std::string::npos);
+  const std::string desk = errorOf("type: desktop\nstereo: {eye_separation: 0.065}\n");
+  EXPECT_NE(desk.find("v.yaml:2"), std::string::npos) << desk;
+  EXPECT_NE(desk.find("wall"), std::string::npos) << desk;
+}
+
+}  // namespace
+}  // namespace mannequin::render

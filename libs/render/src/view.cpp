@@ -20,7 +20,7 @@ ViewConfig fromNode(const core::ConfigNode& root) {
   ViewConfig v;
   v.source = root.file();
   root.allowOnly({"name", "type", "size", "background", "camera", "wall", "head", "head_body", "head_offset", "near",
-                  "far", "style", "sync", "sync_timeout", "layers", "follow"});
+                  "far", "style", "sync", "sync_timeout", "layers", "follow", "stereo"});
   if (auto y = root.find("sync")) v.sync = y->boolean();
   v.sync_timeout = root.getIn("sync_timeout", v.sync_timeout, 0.01, 60.0);
   v.name = root.get("name", v.name);
@@ -57,6 +57,16 @@ ViewConfig fromNode(const core::ConfigNode& root) {
     v.follow = f->str();
     if (v.follow.empty()) f->fail("expected a mannequin name or index");
   }
+  if (auto st = root.find("stereo")) {
+    if (v.type != ViewConfig::Type::kWall) st->fail("only a wall view has stereo (type: wall)");
+    st->allowOnly({"eye_separation", "mode"});
+    v.stereo.enabled = true;
+    if (auto e = st->find("eye_separation")) {
+      v.stereo.eye_separation = e->positive();
+      if (v.stereo.eye_separation > 0.5) e->fail("expected metres between the eyes, in (0, 0.5]");
+    }
+    if (auto m = st->find("mode")) (void)m->choice({"side_by_side"});
+  }
   if (v.type == ViewConfig::Type::kDesktop) {
     for (const char* k : {"wall", "head", "head_body", "head_offset", "near", "far"})
       if (root.has(k)) root[k].fail("only a wall view has this key (type: wall)");
@@ -89,7 +99,7 @@ ViewConfig fromNode(const core::ConfigNode& root) {
     if (auto t = root.find("far")) v.far_plane = t->positive();
     if (v.far_plane <= v.near_plane) root["far"].fail("far must be greater than near");
     try {
-      (void)wallCamera(v.wall, v.head, v.near_plane, v.far_plane);
+      (void)v.eyes(2, 1);  // the head's camera, or both eyes'
     } catch (const std::invalid_argument& e) {
       w.fail(e.what());
     }
@@ -101,6 +111,15 @@ ViewConfig fromNode(const core::ConfigNode& root) {
 Camera ViewConfig::camera(int image_width, int image_height) const {
   if (type == Type::kWall) return wallCamera(wall, head, near_plane, far_plane);
   return orbit.camera(static_cast<double>(image_width) / std::max(1, image_height));
+}
+
+std::vector<EyeView> ViewConfig::eyes(int image_width, int image_height) const {
+  if (type != Type::kWall || !stereo.enabled) return {EyeView{camera(image_width, image_height), 0, image_width}};
+  const Vec3 vr = (wall.lower_right - wall.lower_left).normalized();
+  const Vec3 half = 0.5 * stereo.eye_separation * vr;
+  const int left = image_width / 2;
+  return {EyeView{wallCamera(wall, head - half, near_plane, far_plane), 0, left},
+          EyeView{wallCamera(wall, head + half, near_plane, far_plane), left, image_width - left}};
 }
 
 std::optional<Vec3> trackedHead(const v1::MocapFrame& frame, const ViewConfig& view) {

@@ -18,6 +18,7 @@
 /// head_offset: [0.0, 0.0, 0.08] # optional: the eye in that body's frame (m)
 /// near: 0.05
 /// far: 100
+/// stereo: {eye_separation: 0.065, mode: side_by_side}   # optional: two eyes, left image on the left half
 /// ```
 /// Optional in both: `style: {force_scale: 0.002, force_full: 400}` (m per N, N at full red);
 /// `layers: {mannequins: true, scene: true, objects: true, contacts: true, balance: true, control_frames: true,
@@ -26,6 +27,7 @@
 #include <array>
 #include <optional>
 #include <string>
+#include <vector>
 
 #include "mannequin/render/camera.hpp"
 #include "mannequin/render/scene.hpp"
@@ -35,6 +37,22 @@ class MocapFrame;
 }
 
 namespace mannequin::render {
+
+/// Stereo of a wall view: two off-axis frusta from head ∓ eye_separation/2 · vr (vr = the wall's right axis,
+/// lower_left → lower_right). Side by side: each eye fills one half of the image (left eye on the left),
+/// the wall squeezed horizontally into it (the "half side-by-side" input of stereo projectors).
+struct Stereo {
+  enum class Mode { kSideBySide };
+  bool enabled = false;
+  double eye_separation = 0.065;  ///< m
+  Mode mode = Mode::kSideBySide;
+};
+
+/// One eye's camera and the columns [x, x + width) of the image it fills (all rows).
+struct EyeView {
+  Camera camera;
+  int x = 0, width = 0;
+};
 
 struct ViewConfig {
   enum class Type { kDesktop, kWall };
@@ -52,12 +70,17 @@ struct ViewConfig {
   Style style;
   RenderLayers layers;          ///< `layers:` what is drawn
   std::string follow;           ///< kDesktop `follow:` mannequin name or index ("": the target stays put)
+  Stereo stereo;                ///< kWall `stereo:`
   bool sync = false;            ///< `sync: true`: live nodes pass the swap barrier (render.sync) before each swap
   double sync_timeout = 0.5;    ///< `sync_timeout`: s a node waits for a peer that is late or dead before going on
 
   /// The camera of this view for an image of width × height (desktop: the orbit camera at that aspect;
   /// wall: the off-axis frustum from `head`, independent of the image size).
   Camera camera(int image_width, int image_height) const;
+  /// What to draw into an image_width × image_height image: the one camera() over the whole image, or with
+  /// stereo the left eye's wall camera on columns [0, w/2) and the right eye's on [w/2, w).
+  /// \throws std::invalid_argument when an eye is on or behind the wall plane (see wallCamera).
+  std::vector<EyeView> eyes(int image_width, int image_height) const;
 };
 
 /// \throws core::ConfigError "FILE:LINE: field 'camera.distance': ..." (unknown key, bad value, a wall
