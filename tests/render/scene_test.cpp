@@ -233,6 +233,14 @@ TEST(RenderScene, AControlFrameDrawsItsPoseAndTargetAxesAndAnErrorLineOnlyWhenTh
   const RenderScene same = buildScene(ws, SceneAssets{}, style);
   EXPECT_EQ(same.lines.size(), 3u);
   for (const Polyline& l : same.lines) EXPECT_NE(l.colour, style.control_error_colour);
+  // an occluded frame (tracked false): its target drawn grey
+  ms->mutable_control_frames(0)->set_tracked(false);
+  for (const Polyline& l : buildScene(ws, SceneAssets{}, style).lines) EXPECT_EQ(l.colour, style.control_untracked_colour);
+  // without an achieved pose (or target) nothing is drawn for it but the other
+  ms->mutable_control_frames(0)->clear_actual();
+  const RenderScene no_actual = buildScene(ws, SceneAssets{}, style);
+  EXPECT_EQ(no_actual.count(Layer::kControl), 0u);
+  EXPECT_EQ(no_actual.lines.size(), 3u);
 }
 
 TEST(RenderScene, ConvexHullIsCounterClockwiseWithoutInteriorOrCollinearPoints) {
