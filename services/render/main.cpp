@@ -97,17 +97,14 @@ class NodeLink {
   std::unique_ptr<transport::HealthReporter> health_;
 };
 
-/// The overlay's text line: the sim.world step and time; live also the render fps (frames drawn per
-/// second, smoothed) and the sim lateness (now − the state's send time, ms). Recordings show neither, so
-/// their frames stay deterministic.
+/// The overlay's lines (render::overlayLines): the sim.world step and time; live also the render fps (frames
+/// drawn per second, smoothed) and the lateness (now − the state's send time, ms); the sim's lag behind mocap,
+/// the stale-contact flag and the scenario line. Recordings show no fps nor lateness, so their frames stay
+/// deterministic.
 class OverlayText {
  public:
-  std::string line(const v1::WorldState& ws, bool live) {
-    char buf[160];
-    if (!live) {
-      std::snprintf(buf, sizeof buf, "FRAME %llu  T %.3f S", static_cast<unsigned long long>(ws.step()), ws.sim_time());
-      return buf;
-    }
+  std::vector<render::OverlayLine> line(const v1::WorldState& ws, bool live) {
+    if (!live) return render::overlayLines(ws, nullptr);
     const auto now = std::chrono::steady_clock::now();
     if (last_) {
       const double dt = std::chrono::duration<double>(now - *last_).count();
@@ -115,14 +112,14 @@ class OverlayText {
     }
     last_ = now;
     const std::int64_t sent = ws.header().send_time_ns();
-    const double late_ms = sent > 0 ? static_cast<double>(core::wallNs() - sent) * 1e-6 : 0.0;
-    std::snprintf(buf, sizeof buf, "FRAME %llu  FPS %.1f  LATE %.1f MS", static_cast<unsigned long long>(ws.step()), fps_,
-                  late_ms);
-    return buf;
+    const render::OverlayLive stats{fps_, sent > 0 ? static_cast<double>(core::wallNs() - sent) * 1e-6 : 0.0};
+    return render::overlayLines(ws, &stats);
   }
-  static void draw(render::Renderer& r, const std::string& text, int w, int h) {
-    const float height = std::max(8.0f, static_cast<float>(h) / 40.0f);
-    r.drawOverlay(render::strokeText(text, height, height, height), w, h, {1.0f, 1.0f, 1.0f, 1.0f});
+  /// In every eye's part of the image (a stereo wall: the same text in both halves, on the screen plane).
+  static void draw(render::Renderer& r, const std::vector<render::OverlayLine>& lines,
+                   const std::vector<render::EyeView>& eyes, int h) {
+    for (const auto& [segments, colour] : render::layoutOverlay(lines, h))
+      for (const render::EyeView& e : eyes) r.drawOverlay(segments, e.x, e.width, h, colour);
   }
 
  private:
@@ -154,6 +151,25 @@ void addMissingModels(const v1::WorldState& ws, render::SceneAssets& assets, std
       spdlog::warn("mannequin '{}': no model '{}' ({}); drawn as spheres (pass --sim)", m.name(), m.model(), e.what());
     }
   }
+}
+
+/// What a frame draws of `ws`: its scene with the hidden layers removed.
+render::RenderScene sceneOf(const v1::WorldState& ws, const render::SceneAssets& assets, const render::ViewConfig& view,
+                            const render::RenderLayers& layers) {
+  render::RenderScene s = render::buildScene(ws, assets, view.style);
+  render::applyLayers(s, layers);
+  return s;
+}
+
+/// `view` with its orbit camera's target on the followed mannequin (desktop views with `follow`, or `follow`
+/// given: the window's key F), shifted by the user's pan since the start (`orbit` − the view's own).
+render::ViewConfig followedView(const render::ViewConfig& view, const render::OrbitCamera& orbit, const v1::WorldState* ws,
+                                const std::string& follow) {
+  render::ViewConfig v = view;
+  v.orbit = orbit;
+  if (ws == nullptr || follow.empty() || view.type != render::ViewConfig::Type::kDesktop) return v;
+  v.orbit = render::followed(orbit, *ws, follow, (orbit.target - view.orbit.target).head<2>());
+  return v;
 }
 
 /// Every sim.world message of a recording, in log-time order.
@@ -201,17 +217,17 @@ class LiveWorld {
         if (const auto h = render::trackedHead(f, view)) head_ = h;
       });
   }
-  /// The camera of `view` with the tracked head when there is one; a head that left the room (behind the
-  /// wall) keeps the last usable camera.
-  const render::Camera& camera(const render::ViewConfig& view, int w, int h) {
+  /// The camera(s) of `view` (ViewConfig::eyes: one, or a stereo wall's two) with the tracked head when
+  /// there is one; a head that left the room (an eye behind the wall) keeps the last usable cameras.
+  const std::vector<render::EyeView>& eyes(const render::ViewConfig& view, int w, int h) {
     render::ViewConfig v = view;
     if (head_) v.head = *head_;
     try {
-      camera_ = v.camera(w, h);
+      eyes_ = v.eyes(w, h);
     } catch (const std::invalid_argument& e) {
-      if (!camera_) camera_ = view.camera(w, h);
+      if (eyes_.empty() || eyes_.back().x + eyes_.back().width != w) eyes_ = view.eyes(w, h);
     }
-    return *camera_;
+    return eyes_;
   }
   /// Waits up to `timeout` for traffic; true when a newer state than the last call's arrived.
   bool poll(std::chrono::microseconds timeout) {
@@ -241,7 +257,7 @@ class LiveWorld {
   v1::WorldState latest_;
   long long received_ = 0, seen_ = 0;
   std::optional<render::Vec3> head_;
-  std::optional<render::Camera> camera_;
+  std::vector<render::EyeView> eyes_;
 };
 
 /// Synchronised nodes: the step to draw next (the leader's newest state, or as a follower the leader's
@@ -287,14 +303,17 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
   render::HeadlessContext ctx(w, h);
   render::Renderer renderer;
   spdlog::info("headless {}x{} on {}", w, h, render::Renderer::describeContext());
-  const render::Camera cam = view.camera(w, h);
+  render::RenderLayers layers = view.layers;
+  if (o.overlay) layers.overlay = true;
+  // the camera of a state: the view's, with a desktop `follow` its target on the followed mannequin
+  const auto cameraOf = [&](const v1::WorldState* ws) { return followedView(view, view.orbit, ws, view.follow).eyes(w, h); };
   std::set<std::string> tried;
   long long written = 0;
   OverlayText overlay;
-  const auto emit = [&](const render::RenderScene& scene, const render::Camera& camera, std::size_t index,
+  const auto emit = [&](const render::RenderScene& scene, const std::vector<render::EyeView>& eyes, std::size_t index,
                         const v1::WorldState* ws, bool live) {
-    renderer.draw(scene, camera, w, h, view.background);
-    if (o.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), w, h);
+    renderer.draw(scene, eyes, h, view.background);
+    if (layers.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), eyes, h);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06zu.png", index);
     render::writePng((fs::path(o.out) / name).string(), ctx.read());
@@ -329,8 +348,9 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       const std::uint64_t step = *picked;
       const v1::WorldState* ws = live.stateAt(step);
       addMissingModels(*ws, assets, tried);
-      renderer.draw(render::buildScene(*ws, assets, view.style), live.camera(view, w, h), w, h, view.background);
-      if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+      const auto& eyes = live.eyes(followedView(view, view.orbit, ws, view.follow), w, h);
+      renderer.draw(sceneOf(*ws, assets, view, layers), eyes, h, view.background);
+      if (layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), eyes, h);
       const render::Image img = ctx.read();
       barrier.arriveAndWait(step);
       // the swap: the frame goes out now
@@ -356,12 +376,15 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       const long long index = states++;
       if (index % o.every != 0) continue;
       addMissingModels(live.latest(), assets, tried);
-      emit(render::buildScene(live.latest(), assets, view.style), live.camera(view, w, h), static_cast<std::size_t>(index),
+      emit(sceneOf(live.latest(), assets, view, layers),
+           live.eyes(followedView(view, view.orbit, &live.latest(), view.follow), w, h), static_cast<std::size_t>(index),
            &live.latest(), true);
     }
   } else if (o.from.empty()) {
     // neither a recording nor publishers: the static scene, once
-    emit(render::buildStaticScene(assets, view.style), cam, 0, nullptr, false);
+    render::RenderScene still = render::buildStaticScene(assets, view.style);
+    render::applyLayers(still, layers);
+    emit(still, cameraOf(nullptr), 0, nullptr, false);
   } else {
     const std::vector<v1::WorldState> states = readRecording(o.from);
     if (states.empty()) {
@@ -371,18 +394,41 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     for (std::size_t i = 0; i < states.size(); i += static_cast<std::size_t>(o.every)) {
       if (o.frames > 0 && written >= o.frames) break;
       addMissingModels(states[i], assets, tried);
-      emit(render::buildScene(states[i], assets, view.style), cam, i, &states[i], false);
+      emit(sceneOf(states[i], assets, view, layers), cameraOf(&states[i]), i, &states[i], false);
     }
   }
   std::printf("wrote %lld frames (%dx%d) to %s\n", written, w, h, o.out.c_str());
   return core::kExitOk;
 }
 
-struct Mouse {
+/// A window's input state (mouse: orbit, pan, zoom; keys: docs/render.md "Keys").
+struct Input {
   render::OrbitCamera* orbit = nullptr;
+  const render::ViewConfig* view = nullptr;
   double x = 0, y = 0;
   bool left = false, right = false;
+  render::RenderLayers layers;  // 1..7 toggle
+  std::string follow;           // F toggles between "" and the view's `follow` (or mannequin 0)
+  bool paused = false;          // P: the drawn state is frozen
 };
+
+void onKey(GLFWwindow* w, int key, int, int action, int) {
+  if (action != GLFW_PRESS) return;
+  auto* in = static_cast<Input*>(glfwGetWindowUserPointer(w));
+  if (key >= GLFW_KEY_1 && key < GLFW_KEY_1 + render::RenderLayers::kCount) {
+    const int i = key - GLFW_KEY_1;
+    in->layers.flag(i) = !in->layers.flag(i);
+    spdlog::info("layer {} {}", render::RenderLayers::names()[static_cast<std::size_t>(i)], in->layers.flag(i) ? "on" : "off");
+  } else if (key == GLFW_KEY_F && in->view->type == render::ViewConfig::Type::kDesktop) {
+    in->follow = in->follow.empty() ? (in->view->follow.empty() ? std::string("0") : in->view->follow) : std::string();
+    spdlog::info("follow {}", in->follow.empty() ? "off" : in->follow);
+  } else if (key == GLFW_KEY_P) {
+    in->paused = !in->paused;
+    spdlog::info("{}", in->paused ? "paused" : "running");
+  } else if (key == GLFW_KEY_R) {
+    *in->orbit = in->view->orbit;
+  }
+}
 
 int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAssets& assets, NodeLink& link) {
   const char* x11 = std::getenv("DISPLAY");
@@ -425,28 +471,34 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
     render::Renderer renderer;
     spdlog::info("window {}x{} on {}", view.width, view.height, render::Renderer::describeContext());
     render::OrbitCamera orbit = view.orbit;
-    Mouse mouse{&orbit};
+    Input mouse;
+    mouse.orbit = &orbit;
+    mouse.view = &view;
+    mouse.layers = view.layers;
+    if (o.overlay) mouse.layers.overlay = true;
+    mouse.follow = view.follow;
     glfwSetWindowUserPointer(win, &mouse);
+    glfwSetKeyCallback(win, onKey);
     if (view.type == render::ViewConfig::Type::kDesktop) {
       glfwSetMouseButtonCallback(win, [](GLFWwindow* w, int button, int action, int) {
-        auto* m = static_cast<Mouse*>(glfwGetWindowUserPointer(w));
+        auto* m = static_cast<Input*>(glfwGetWindowUserPointer(w));
         if (button == GLFW_MOUSE_BUTTON_LEFT) m->left = action == GLFW_PRESS;
         if (button == GLFW_MOUSE_BUTTON_RIGHT) m->right = action == GLFW_PRESS;
       });
       glfwSetCursorPosCallback(win, [](GLFWwindow* w, double x, double y) {
-        auto* m = static_cast<Mouse*>(glfwGetWindowUserPointer(w));
+        auto* m = static_cast<Input*>(glfwGetWindowUserPointer(w));
         if (m->left) m->orbit->rotate(-0.01 * (x - m->x), 0.01 * (y - m->y));
         if (m->right) m->orbit->pan(-0.002 * m->orbit->distance * (x - m->x), 0.002 * m->orbit->distance * (y - m->y));
         m->x = x;
         m->y = y;
       });
       glfwSetScrollCallback(win, [](GLFWwindow* w, double, double dy) {
-        static_cast<Mouse*>(glfwGetWindowUserPointer(w))->orbit->zoom(std::pow(0.9, dy));
+        static_cast<Input*>(glfwGetWindowUserPointer(w))->orbit->zoom(std::pow(0.9, dy));
       });
     }
     const auto start = std::chrono::steady_clock::now();
     const auto& stop = core::installStopSignals();
-    const render::RenderScene still = render::buildStaticScene(assets, view.style);
+    const render::RenderScene still_all = render::buildStaticScene(assets, view.style);
     long long swapped = 0;
     OverlayText overlay;
     if (view.sync) {
@@ -478,11 +530,10 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         const v1::WorldState* ws = live->stateAt(*picked);
         int w = 0, h = 0;
         glfwGetFramebufferSize(win, &w, &h);
-        render::ViewConfig v = view;
-        v.orbit = orbit;
         addMissingModels(*ws, assets, tried);
-        renderer.draw(render::buildScene(*ws, assets, view.style), live->camera(v, w, h), w, h, view.background);
-        if (o.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), w, h);
+        const auto& eyes = live->eyes(followedView(view, orbit, ws, mouse.follow), w, h);
+        renderer.draw(sceneOf(*ws, assets, view, mouse.layers), eyes, h, view.background);
+        if (mouse.layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, true), eyes, h);
         glFinish();
         barrier.arriveAndWait(*picked);
         glfwSwapBuffers(win);
@@ -492,32 +543,48 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
         last = *picked;
       }
     }
+    std::optional<v1::WorldState> held;  // P: the state frozen on the screen
+    bool held_live = false;
     while (!view.sync && !glfwWindowShouldClose(win) && !stop.load()) {
       int w = 0, h = 0;
       glfwGetFramebufferSize(win, &w, &h);
-      render::ViewConfig v = view;
-      v.orbit = orbit;
       if (live) live->poll(std::chrono::microseconds(0));
-      const render::Camera cam = live ? live->camera(v, w, h) : v.camera(w, h);
+      // the state to draw: the newest live one, or the recording's at its sim time (looping); none: the scene
+      const v1::WorldState* ws = nullptr;
+      bool is_live = false;
       if (live) {
-        if (live->received() == 0) {
-          renderer.draw(still, cam, w, h, view.background);
-        } else {
-          addMissingModels(live->latest(), assets, tried);
-          renderer.draw(render::buildScene(live->latest(), assets, view.style), cam, w, h, view.background);
-          if (o.overlay) OverlayText::draw(renderer, overlay.line(live->latest(), true), w, h);
+        if (live->received() > 0) {
+          ws = &live->latest();
+          is_live = true;
         }
-      } else if (states.empty()) {
-        renderer.draw(still, cam, w, h, view.background);
-      } else {  // play at the recording's sim time, looping
+      } else if (!states.empty()) {
         const double span = std::max(1e-9, states.back().sim_time() - states.front().sim_time());
         const double t = std::fmod(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count(), span) +
                          states.front().sim_time();
         std::size_t i = 0;
         while (i + 1 < states.size() && states[i + 1].sim_time() <= t) ++i;
-        addMissingModels(states[i], assets, tried);
-        renderer.draw(render::buildScene(states[i], assets, view.style), cam, w, h, view.background);
-        if (o.overlay) OverlayText::draw(renderer, overlay.line(states[i], false), w, h);
+        ws = &states[i];
+      }
+      if (mouse.paused && ws != nullptr) {
+        if (!held) {
+          held = *ws;
+          held_live = is_live;
+        }
+        ws = &*held;
+        is_live = held_live;
+      } else if (!mouse.paused) {
+        held.reset();
+      }
+      const render::ViewConfig v = followedView(view, orbit, ws, mouse.follow);
+      const std::vector<render::EyeView> cam = live ? live->eyes(v, w, h) : v.eyes(w, h);
+      if (ws == nullptr) {
+        render::RenderScene still = still_all;
+        render::applyLayers(still, mouse.layers);
+        renderer.draw(still, cam, h, view.background);
+      } else {
+        addMissingModels(*ws, assets, tried);
+        renderer.draw(sceneOf(*ws, assets, view, mouse.layers), cam, h, view.background);
+        if (mouse.layers.overlay) OverlayText::draw(renderer, overlay.line(*ws, is_live), cam, h);
       }
       glfwSwapBuffers(win);
       glfwPollEvents();

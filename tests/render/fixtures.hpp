@@ -62,4 +62,18 @@ inline v1::ContactPoint* addContact(v1::MannequinState& ms, const math::Vector3&
   return c;
 }
 
+/// Adds control frame `frame` with its achieved pose and target (world) to a mannequin.
+inline v1::ControlFrameState* addControlFrame(v1::MannequinState& ms, const std::string& frame, const SE3& actual,
+                                              const SE3& target, bool tracked = true) {
+  v1::ControlFrameState* cf = ms.add_control_frames();
+  cf->set_frame(frame);
+  cf->set_mode("free");
+  toMsg(actual, *cf->mutable_actual());
+  toMsg(target, *cf->mutable_target());
+  cf->set_position_error((target.p - actual.p).norm());
+  cf->set_tracked(tracked);
+  cf->set_weight(tracked ? 1.0 : 0.0);
+  return cf;
+}
+
 }  // namespace mannequin::render::testing

@@ -5,6 +5,7 @@
 #include <filesystem>
 #include <fstream>
 #include <memory>
+#include <tuple>
 
 #include "fixtures.hpp"
 #include "mannequin/render/renderer.hpp"
@@ -150,6 +151,196 @@ TEST_F(Scenes, AContactForceDrawsAnArrowOfTheForceColourWhereItPointsAndNotWitho
   EXPECT_GT(cam_.pixel(point + force.normalized() * len, kW, kH).x(), cam_.pixel(point, kW, kH).x() + 30);
 }
 
+bool isControlError(const std::array<std::uint8_t, 3>& c) { return c[0] > 200 && c[1] < 100 && c[2] > 150; }
+
+TEST_F(Headless, AControlFrameErrorLineRunsBetweenThePoseAndTheTargetAndVanishesWhenTheyCoincide) {
+  OrbitCamera orbit;
+  orbit.target = Vec3(0, 0.2, 1.0);
+  orbit.distance = 1.6;
+  orbit.yaw = 0.0;  // +y is image right
+  orbit.pitch = 0.0;
+  const Camera cam = orbit.camera(static_cast<double>(kW) / kH);
+  const SE3 actual(Eigen::Matrix3d::Identity(), Vec3(0, 0.0, 1.0));
+  const SE3 target(Eigen::Matrix3d::Identity(), Vec3(0, 0.4, 1.1));
+  v1::WorldState ws;
+  v1::MannequinState* ms = ws.add_mannequins();
+  ms->set_name("alice");
+  testing::addControlFrame(*ms, "hand_r", actual, target);
+  const Image img = render(buildScene(ws, SceneAssets{}), cam);
+  const Eigen::Vector2d pa = cam.pixel(actual.p, kW, kH), pt = cam.pixel(target.p, kW, kH);
+  ASSERT_GT(pt.x() - pa.x(), 60);  // the target is well to the right of the pose
+  Box line;
+  line.add(pa);
+  line.add(pt);
+  int inside = 0, outside = 0;
+  double x_min = 1e9, x_max = -1e9;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x)
+      if (isControlError(img.at(x, y))) {
+        if (!line.contains(x + 0.5, y + 0.5, 1.5)) {
+          ++outside;
+          continue;
+        }
+        ++inside;
+        // on the segment between the projected points (a 1 px line)
+        const Eigen::Vector2d d = (pt - pa).normalized(), r = Eigen::Vector2d(x + 0.5, y + 0.5) - pa;
+        EXPECT_LT(std::abs(d.x() * r.y() - d.y() * r.x()), 1.5) << x << "," << y;
+        x_min = std::min(x_min, x + 0.5);
+        x_max = std::max(x_max, x + 0.5);
+      }
+  EXPECT_EQ(outside, 0);
+  // continuous from near the pose to near the target (the axes may hide a few pixels at either end)
+  EXPECT_GE(inside, 0.8 * (pt.x() - pa.x()));
+  EXPECT_LT(x_min, pa.x() + 0.2 * (pt.x() - pa.x()));
+  EXPECT_GT(x_max, pt.x() - 0.2 * (pt.x() - pa.x()));
+  // target on the pose: no error line anywhere (its axes are still drawn)
+  ms->mutable_control_frames(0)->mutable_target()->CopyFrom(ms->control_frames(0).actual());
+  const Image same = render(buildScene(ws, SceneAssets{}), cam);
+  int error_same = 0, axes_same = 0;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      error_same += isControlError(same.at(x, y)) ? 1 : 0;
+      axes_same += same.at(x, y) != img.at(0, 0) ? 1 : 0;
+    }
+  EXPECT_EQ(error_same, 0);
+  EXPECT_GT(axes_same, 20);
+}
+
+TEST_F(Scenes, ALayerSwitchedOffLeavesNoPixelOfItsColour) {
+  testing::addContact(*ms_, Vec3(0.0, 0.45, 1.2), Vec3::UnitY(), Vec3(0, 250, 0), "alice/hand_r", "wall");
+  testing::addControlFrame(*ms_, "hand_l", SE3(Eigen::Matrix3d::Identity(), Vec3(0, -0.6, 1.0)),
+                           SE3(Eigen::Matrix3d::Identity(), Vec3(0, -0.9, 1.1)));
+  const auto countOf = [&](const Image& img, bool (*cls)(const std::array<std::uint8_t, 3>&)) {
+    int n = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) n += cls(img.at(x, y)) ? 1 : 0;
+    return n;
+  };
+  const RenderScene all = buildScene(ws_, assets_);
+  const Image full = render(all, cam_);
+  ASSERT_GT(countOf(full, isMannequinBlue), 1000);
+  ASSERT_GT(countOf(full, isForce), 20);
+  ASSERT_GT(countOf(full, isControlError), 10);
+  // the control frame's axes are red, green and blue (the usual convention), hues the force and mannequin
+  // classes also match: those two cases hide the control frames too, and look for the error line's magenta
+  struct Case {
+    RenderLayers layers;
+    bool (*cls)(const std::array<std::uint8_t, 3>&);
+    const char* what;
+  };
+  RenderLayers no_mannequins, no_contacts, no_control;
+  no_mannequins.mannequins = no_mannequins.control_frames = false;
+  no_contacts.contacts = no_contacts.control_frames = false;
+  no_control.control_frames = false;
+  for (const Case& c : {Case{no_mannequins, isMannequinBlue, "mannequins"}, Case{no_contacts, isForce, "contacts"},
+                        Case{no_control, isControlError, "control_frames"}}) {
+    RenderScene s = all;
+    applyLayers(s, c.layers);
+    const Image img = render(s, cam_);
+    EXPECT_EQ(countOf(img, c.cls), 0) << c.what << " off";
+    // the layers still on are still drawn
+    if (c.layers.mannequins) {
+      EXPECT_GT(countOf(img, isMannequinBlue), 1000) << c.what << " off";
+    }
+    if (c.layers.contacts) {
+      EXPECT_GT(countOf(img, isForce), 20) << c.what << " off";
+    }
+  }
+  // and the colour classes do not hide one another: switching off every layer but one leaves its colour
+  RenderLayers only_control;
+  only_control.mannequins = only_control.scene = only_control.objects = only_control.contacts = only_control.balance = false;
+  RenderScene s = all;
+  applyLayers(s, only_control);
+  EXPECT_EQ(s.count(Layer::kControl), 3u);
+  EXPECT_EQ(s.solids.size(), 3u);
+  EXPECT_GT(countOf(render(s, cam_), isControlError), 10);
+}
+
+TEST_F(Scenes, AFollowingCameraKeepsAMannequinWalking2MetresNearTheImageCentre) {
+  // the mannequin walks 2 m along +y (image right from this camera): its blue pixels' mean column
+  const auto meanColumn = [&](const Image& img) {
+    double sum = 0;
+    int n = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x)
+        if (isMannequinBlue(img.at(x, y))) { sum += x + 0.5; ++n; }
+    return std::make_pair(n, n ? sum / n : -1.0);
+  };
+  const math::VectorX q0 = skeleton::standingConfiguration(*model_);
+  double still_last = 0;
+  int still_n = 0;
+  for (int k = 0; k <= 4; ++k) {
+    math::VectorX q = q0;
+    q[1] += 0.5 * k;  // root position y
+    v1::WorldState ws;
+    testing::addMannequin(ws, *model_, q, "alice");
+    const OrbitCamera follow = followed(orbit_, ws, "alice");
+    const auto [n, x] = meanColumn(render(buildScene(ws, assets_), follow.camera(static_cast<double>(kW) / kH)));
+    ASSERT_GT(n, 1000) << "step " << k;
+    EXPECT_NEAR(x, 0.5 * kW, 0.05 * kW) << "step " << k;  // the figure stays centred (its pelvis is the target)
+    std::tie(still_n, still_last) = meanColumn(render(buildScene(ws, assets_), cam_));
+  }
+  // without following, the same walk takes it out of the picture (at least most of it)
+  EXPECT_TRUE(still_n < 300 || still_last > 0.85 * kW) << still_n << " px at column " << still_last;
+}
+
+TEST_F(Headless, StereoSideBySideHalvesShowCrossedParallaxInFrontOfTheWallAndUncrossedBehindIt) {
+  ViewConfig view = parseView(
+      "type: wall\nwall: {lower_left: [1.5, 1.5, 0], lower_right: [1.5, -1.5, 0], upper_left: [1.5, 1.5, 3]}\n"
+      "head: [0, 0, 1.5]\nstereo: {eye_separation: 0.2, mode: side_by_side}\n",
+      "stereo.yaml");
+  const auto eyes = view.eyes(kW, kH);
+  ASSERT_EQ(eyes.size(), 2u);
+  // mean column (within its half) of the blue pixels of each half
+  const auto columns = [&](const Image& img) {
+    std::array<double, 2> sum{0, 0};
+    std::array<int, 2> n{0, 0};
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x)
+        if (isMannequinBlue(img.at(x, y))) {
+          const std::size_t half = x < eyes[1].x ? 0 : 1;
+          sum[half] += x + 0.5 - eyes[half].x;
+          ++n[half];
+        }
+    EXPECT_GT(n[0], 4);
+    EXPECT_GT(n[1], 4);
+    return std::array<double, 2>{sum[0] / std::max(1, n[0]), sum[1] / std::max(1, n[1])};
+  };
+  const auto ball = [](const Vec3& p, double r) {
+    RenderScene s;
+    Primitive b;
+    b.kind = Kind::kSphere;
+    b.radius = r;
+    b.pose.p = p;
+    b.colour = Style{}.mannequin_colours[0];
+    s.solids.push_back(b);
+    return s;
+  };
+  struct Case {
+    Vec3 p;
+    double r;
+    int sign;  // of (left column − right column): + crossed (in front of the wall), − uncrossed (behind)
+  };
+  for (const Case& c : {Case{Vec3(0.6, 0, 1.5), 0.03, +1}, Case{Vec3(4.5, 0, 1.5), 0.15, -1}}) {
+    ctx_->makeCurrent();
+    renderer_->draw(ball(c.p, c.r), eyes, kH, {0.11f, 0.12f, 0.14f});
+    const Image img = ctx_->read();
+    const auto seen = columns(img);
+    const double expected_left = eyes[0].camera.pixel(c.p, eyes[0].width, kH).x();
+    const double expected_right = eyes[1].camera.pixel(c.p, eyes[1].width, kH).x();
+    const double parallax = expected_left - expected_right;
+    EXPECT_GT(c.sign * parallax, 5.0) << c.p.transpose();  // the case is meaningful: several pixels
+    EXPECT_NEAR(seen[0], expected_left, 1.0) << c.p.transpose();
+    EXPECT_NEAR(seen[1], expected_right, 1.0) << c.p.transpose();
+    EXPECT_GT(c.sign * (seen[0] - seen[1]), 0.7 * std::abs(parallax)) << c.p.transpose();
+  }
+  // on the wall plane there is no parallax
+  ctx_->makeCurrent();
+  renderer_->draw(ball(Vec3(1.5, 0, 1.5), 0.05), eyes, kH, {0.11f, 0.12f, 0.14f});
+  const auto on = columns(ctx_->read());
+  EXPECT_NEAR(on[0], on[1], 1.0);
+}
+
 TEST_F(Scenes, TwoWallViewsOfOneFrameAgreeAtTheirSharedEdge) {
   const ViewConfig front = loadView(testing::sourcePath("configs/views/wall_front.yaml"));
   const ViewConfig right = loadView(testing::sourcePath("configs/views/wall_right.yaml"));
@@ -282,6 +473,92 @@ TEST_F(OverlayPixels, TextIsDrawnInsideItsBoxAndTheChangedDigitChangesOnlyItsCel
       }
   EXPECT_GT(changed, 5);
   EXPECT_EQ(changed_elsewhere, 0);
+}
+
+}  // namespace
+}  // namespace mannequin::render
+
+namespace mannequin::render {
+namespace {
+
+TEST(OverlayText, StatusStaleContactsAndScenarioLines) {
+  v1::WorldState ws;
+  ws.set_step(1200);
+  ws.set_sim_time(1.2);
+  auto lines = overlayLines(ws, nullptr);
+  ASSERT_EQ(lines.size(), 1u);
+  EXPECT_EQ(lines[0].text, "FRAME 1200  T 1.200 S");
+  const OverlayLive live{59.5, 12.25};
+  EXPECT_EQ(overlayLines(ws, &live)[0].text, "FRAME 1200  FPS 59.5  LATE 12.2 MS");
+  // the sim's lag behind mocap needs both send times
+  ws.mutable_header()->set_send_time_ns(5'000'000'000);
+  EXPECT_EQ(overlayLines(ws, nullptr)[0].text, "FRAME 1200  T 1.200 S");
+  ws.mutable_mocap()->set_send_time_ns(4'996'500'000);
+  EXPECT_EQ(overlayLines(ws, nullptr)[0].text, "FRAME 1200  T 1.200 S  SIM LAG 3.5 MS");
+  // stale contacts: the warning line, in the warning colour
+  ws.set_contacts_stale(true);
+  ws.set_contacts_step(1197);
+  const OverlayStyle style;
+  lines = overlayLines(ws, nullptr, style);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[1].text, "CONTACTS STALE  3 STEPS OLD");
+  EXPECT_EQ(lines[1].colour, style.warning);
+  // scenario: mechanisms, frames not free by mode, occluded mocap-driven frames
+  ws.set_contacts_stale(false);
+  ws.add_active_mechanisms("door_hinge");
+  v1::MannequinState* m = ws.add_mannequins();
+  m->set_name("operator");
+  for (const auto& [frame, mode, body, tracked] :
+       {std::tuple{"hand_l", "constrained", "lhand", true}, std::tuple{"hand_r", "free", "rhand", false},
+        std::tuple{"foot_l", "autonomous", "", false}, std::tuple{"foot_r", "constrained", "rfoot", true}}) {
+    v1::ControlFrameState* cf = m->add_control_frames();
+    cf->set_frame(frame);
+    cf->set_mode(mode);
+    cf->set_body(body);
+    cf->set_tracked(tracked);
+  }
+  lines = overlayLines(ws, nullptr, style);
+  ASSERT_EQ(lines.size(), 2u);
+  EXPECT_EQ(lines[1].text, "MECHANISMS DOOR_HINGE  AUTONOMOUS FOOT_L  CONSTRAINED HAND_L FOOT_R  OCCLUDED HAND_R");
+  EXPECT_EQ(lines[1].colour, style.scenario);
+  ws.add_mannequins()->set_name("bob");  // several mannequins: frames carry their mannequin's name
+  EXPECT_NE(overlayLines(ws, nullptr)[1].text.find("CONSTRAINED OPERATOR/HAND_L OPERATOR/FOOT_R"), std::string::npos);
+  for (const char c : std::string("_,")) EXPECT_TRUE(hasGlyph(c)) << c;
+}
+
+TEST_F(OverlayPixels, TheStaleContactFlagIsDrawnInTheWarningColourOnlyWhenContactsAreStale) {
+  // a 200 × 60 image: capital height 8 px, line 2 at rows 22..30
+  const auto draw = [&](const v1::WorldState& ws) {
+    ViewConfig view;
+    renderer_->draw(RenderScene{}, view.camera(kW, kH), kW, kH, {0.1f, 0.1f, 0.1f});
+    for (const auto& [segments, colour] : layoutOverlay(overlayLines(ws, nullptr), kH))
+      renderer_->drawOverlay(segments, kW, kH, colour);
+    return ctx_->read();
+  };
+  const auto orange = [](const std::array<std::uint8_t, 3>& c) { return c[0] > 200 && c[1] > 80 && c[1] < 150 && c[2] < 60; };
+  v1::WorldState ws;
+  ws.set_step(42);
+  ws.set_contacts_step(40);
+  const Image fresh = draw(ws);
+  ws.set_contacts_stale(true);
+  const Image stale = draw(ws);
+  int orange_fresh = 0, orange_stale = 0, orange_outside = 0, lit_below_fresh = 0;
+  const float h = 8.0f, top = h + 1.75f * h;
+  for (int y = 0; y < kH; ++y)
+    for (int x = 0; x < kW; ++x) {
+      orange_fresh += orange(fresh.at(x, y)) ? 1 : 0;
+      if (y > top + h + 1 && fresh.at(x, y) != fresh.at(kW - 1, kH - 1)) ++lit_below_fresh;
+      if (!orange(stale.at(x, y))) continue;
+      ++orange_stale;
+      if (y < top - 1 || y > top + h + 1) ++orange_outside;
+    }
+  EXPECT_EQ(orange_fresh, 0);
+  EXPECT_EQ(lit_below_fresh, 0);  // no second line at all
+  EXPECT_EQ(orange_outside, 0);   // the flag is on its line
+  EXPECT_GE(orange_stale, 10 * 8);  // "CONTACTS STALE": a dozen glyphs of at least one 8 px stroke
+  // the first line is the same in both
+  for (int y = 0; y < static_cast<int>(top) - 1; ++y)
+    for (int x = 0; x < kW; ++x) ASSERT_EQ(fresh.at(x, y), stale.at(x, y)) << x << "," << y;
 }
 
 }  // namespace

@@ -481,6 +481,15 @@ TEST(RenderTool, OpensAWindowUnderXvfb) {
   EXPECT_NE(r.err.find("window 1280x720"), std::string::npos) << r.err;
 }
 
+TEST(RenderTool, AStereoWallWritesOneSideBySideImage) {
+  const fs::path d = temp("stereo");
+  const ToolRun r = run("--view configs/views/wall_front_stereo.yaml --scene configs/scenes/table.yaml --headless --size 200x100 --out " +
+                        d.string());
+  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_NE(r.out.find("wrote 1 frames (200x100)"), std::string::npos) << r.out;
+  EXPECT_TRUE(fs::exists(d / "frame_000000.png"));
+}
+
 TEST(RenderTool, BadSizeAndMissingOutAreUsageErrors) {
   const ToolRun size = run("--headless --size 12x --out " + temp("o").string());
   EXPECT_EQ(size.status, 2) << size.err;

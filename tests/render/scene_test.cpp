@@ -3,6 +3,7 @@
 
 #include "fixtures.hpp"
 #include "mannequin/collision/scene.hpp"
+#include "mannequin/math/frame.hpp"
 #include "mannequin/render/scene.hpp"
 
 namespace mannequin::render {
@@ -188,6 +189,58 @@ TEST(RenderScene, SupportPolygonIsTheHullOfTheFeetContactsOnTheFloor) {
     EXPECT_TRUE(corner) << p.transpose();
   }
   EXPECT_EQ(scene.countTagged("com:alice"), 1u);
+}
+
+TEST(RenderScene, AControlFrameDrawsItsPoseAndTargetAxesAndAnErrorLineOnlyWhenTheyDiffer) {
+  v1::WorldState ws;
+  v1::MannequinState* ms = ws.add_mannequins();
+  ms->set_name("alice");
+  const SE3 actual(math::frameAlong(Vector3(0, 1, 0)), Vector3(0.3, 0.1, 1.0));
+  const SE3 target(math::Matrix3::Identity(), Vector3(0.3, 0.4, 1.1));
+  testing::addControlFrame(*ms, "hand_r", actual, target);
+  const Style style;
+  const RenderScene scene = buildScene(ws, SceneAssets{}, style);
+  EXPECT_EQ(scene.count(Layer::kControl), 3u);  // the achieved pose's three axes
+  EXPECT_EQ(scene.countTagged("control:alice/hand_r"), 3u);
+  for (const Primitive& p : scene.solids) {
+    if (p.layer != Layer::kControl) continue;
+    // each axis cylinder starts at the frame's origin and runs along one of its axes
+    const Vector3 start = p.pose.p - 0.5 * p.length * p.pose.R.col(2);
+    EXPECT_LT((start - actual.p).norm(), 1e-12);
+    EXPECT_NEAR(p.length, style.control_axis_length, 1e-12);
+    double best = 0;
+    for (int a = 0; a < 3; ++a) best = std::max(best, p.pose.R.col(2).dot(actual.R.col(a)));
+    EXPECT_NEAR(best, 1.0, 1e-12);
+  }
+  int target_axes = 0, error_lines = 0;
+  for (const Polyline& l : scene.lines) {
+    ASSERT_EQ(l.layer, Layer::kControl);
+    ASSERT_EQ(l.points.size(), 2u);
+    if (l.colour == style.control_error_colour) {
+      ++error_lines;
+      EXPECT_LT((l.points[0] - actual.p).norm(), 1e-12);
+      EXPECT_LT((l.points[1] - target.p).norm(), 1e-12);
+    } else {
+      ++target_axes;
+      EXPECT_LT((l.points[0] - target.p).norm(), 1e-12);
+      EXPECT_NEAR((l.points[1] - l.points[0]).norm(), style.control_axis_length, 1e-12);
+    }
+  }
+  EXPECT_EQ(target_axes, 3);
+  EXPECT_EQ(error_lines, 1);
+  // the target on the pose: axes, no error line
+  ms->mutable_control_frames(0)->mutable_target()->CopyFrom(ms->control_frames(0).actual());
+  const RenderScene same = buildScene(ws, SceneAssets{}, style);
+  EXPECT_EQ(same.lines.size(), 3u);
+  for (const Polyline& l : same.lines) EXPECT_NE(l.colour, style.control_error_colour);
+  // an occluded frame (tracked false): its target drawn grey
+  ms->mutable_control_frames(0)->set_tracked(false);
+  for (const Polyline& l : buildScene(ws, SceneAssets{}, style).lines) EXPECT_EQ(l.colour, style.control_untracked_colour);
+  // without an achieved pose (or target) nothing is drawn for it but the other
+  ms->mutable_control_frames(0)->clear_actual();
+  const RenderScene no_actual = buildScene(ws, SceneAssets{}, style);
+  EXPECT_EQ(no_actual.count(Layer::kControl), 0u);
+  EXPECT_EQ(no_actual.lines.size(), 3u);
 }
 
 TEST(RenderScene, ConvexHullIsCounterClockwiseWithoutInteriorOrCollinearPoints) {

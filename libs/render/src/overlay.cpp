@@ -1,7 +1,12 @@
 #include "mannequin/render/overlay.hpp"
 
+#include <algorithm>
 #include <cctype>
+#include <cstdio>
 #include <cstring>
+#include <map>
+
+#include "mannequin/v1/world.pb.h"
 
 namespace mannequin::render {
 namespace {
@@ -25,6 +30,8 @@ const char* glyph(char c) {
     case '-': return "0222";
     case '/': return "0024";
     case '%': return "0024 0314 1020";
+    case '_': return "0020";
+    case ',': return "1110";
     case 'A': return "0003142320 0222";
     case 'B': return "0004142312211000 0212";
     case 'C': return "24040020";
@@ -80,6 +87,73 @@ std::vector<Segment2> strokeText(std::string_view text, float x, float y, float 
     }
     cx += 3.0f * u;
   }
+  return out;
+}
+
+namespace {
+std::string upper(std::string s) {
+  for (char& c : s) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+}  // namespace
+
+std::vector<OverlayLine> overlayLines(const v1::WorldState& ws, const OverlayLive* live, const OverlayStyle& style) {
+  std::vector<OverlayLine> out;
+  char buf[200];
+  const auto step = static_cast<unsigned long long>(ws.step());
+  if (live == nullptr)
+    std::snprintf(buf, sizeof buf, "FRAME %llu  T %.3f S", step, ws.sim_time());
+  else
+    std::snprintf(buf, sizeof buf, "FRAME %llu  FPS %.1f  LATE %.1f MS", step, live->fps, live->late_ms);
+  std::string first = buf;
+  // the sim's lateness behind mocap: this state's send time − the send time of the newest mocap frame it used
+  const std::int64_t sent = ws.header().send_time_ns(), mocap_sent = ws.mocap().send_time_ns();
+  if (sent > 0 && mocap_sent > 0) {
+    std::snprintf(buf, sizeof buf, "  SIM LAG %.1f MS", static_cast<double>(sent - mocap_sent) * 1e-6);
+    first += buf;
+  }
+  out.push_back({first, style.text});
+  if (ws.contacts_stale()) {
+    const std::uint64_t behind = ws.step() >= ws.contacts_step() ? ws.step() - ws.contacts_step() : 0;
+    std::snprintf(buf, sizeof buf, "CONTACTS STALE  %llu STEPS OLD", static_cast<unsigned long long>(behind));
+    out.push_back({buf, style.warning});
+  }
+  // the scenario as sim.world shows it: active mechanisms, control frames not in mode "free", occluded ones
+  std::string scenario;
+  if (ws.active_mechanisms_size() > 0) {
+    scenario += "MECHANISMS";
+    for (const std::string& m : ws.active_mechanisms()) {
+      scenario.push_back(' ');
+      scenario.append(upper(m));
+    }
+  }
+  std::map<std::string, std::string> by_mode;  // mode → frames (ordered: deterministic)
+  std::string occluded;
+  const bool prefix = ws.mannequins_size() > 1;
+  for (const v1::MannequinState& m : ws.mannequins())
+    for (const v1::ControlFrameState& cf : m.control_frames()) {
+      std::string name = " ";
+      if (prefix) name.append(upper(m.name())).push_back('/');
+      name.append(upper(cf.frame()));
+      if (!cf.mode().empty() && cf.mode() != "free") by_mode[upper(cf.mode())].append(name);
+      if (!cf.tracked() && !cf.body().empty()) occluded.append(name);
+    }
+  const auto group = [&scenario](const std::string& head, const std::string& names) {
+    if (!scenario.empty()) scenario.append("  ");
+    scenario.append(head).append(names);
+  };
+  for (const auto& [mode, frames] : by_mode) group(mode, frames);
+  if (!occluded.empty()) group("OCCLUDED", occluded);
+  if (!scenario.empty()) out.push_back({scenario, style.scenario});
+  return out;
+}
+
+std::vector<std::pair<std::vector<Segment2>, Colour>> layoutOverlay(const std::vector<OverlayLine>& lines,
+                                                                    int image_height) {
+  const float h = std::max(8.0f, static_cast<float>(image_height) / 40.0f);
+  std::vector<std::pair<std::vector<Segment2>, Colour>> out;
+  for (std::size_t i = 0; i < lines.size(); ++i)
+    out.emplace_back(strokeText(lines[i].text, h, h + 1.75f * h * static_cast<float>(i), h), lines[i].colour);
   return out;
 }
 

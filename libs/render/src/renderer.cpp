@@ -239,9 +239,22 @@ void Renderer::drawMesh(const Mesh& mesh, const Eigen::Matrix4d& model, const Co
 
 void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, int height,
                     const std::array<float, 3>& background) {
-  glViewport(0, 0, width, height);
+  draw(scene, camera, 0, 0, width, height, background);
+}
+
+void Renderer::draw(const RenderScene& scene, const std::vector<EyeView>& eyes, int height,
+                    const std::array<float, 3>& background) {
+  for (const EyeView& e : eyes) draw(scene, e.camera, e.x, 0, e.width, height, background);
+}
+
+void Renderer::draw(const RenderScene& scene, const Camera& camera, int x, int y, int width, int height,
+                    const std::array<float, 3>& background) {
+  glViewport(x, y, width, height);
+  glEnable(GL_SCISSOR_TEST);
+  glScissor(x, y, width, height);
   glClearColor(background[0], background[1], background[2], 1.0f);
   glClear(GL_COLOR_BUFFER_BIT | GL_DEPTH_BUFFER_BIT);
+  glDisable(GL_SCISSOR_TEST);
   glEnable(GL_DEPTH_TEST);
   glDepthFunc(GL_LESS);
   glDisable(GL_CULL_FACE);
@@ -299,8 +312,12 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int width, i
 }
 
 void Renderer::drawOverlay(const std::vector<Segment2>& segments, int width, int height, const Colour& colour) {
+  drawOverlay(segments, 0, width, height, colour);
+}
+
+void Renderer::drawOverlay(const std::vector<Segment2>& segments, int x, int width, int height, const Colour& colour) {
   if (segments.empty() || width <= 0 || height <= 0) return;
-  glViewport(0, 0, width, height);
+  glViewport(x, 0, width, height);
   glDisable(GL_DEPTH_TEST);
   glUseProgram(program_);
   glUniform1i(u_unlit_, 1);

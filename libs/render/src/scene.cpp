@@ -89,6 +89,42 @@ std::size_t RenderScene::countTagged(const std::string& prefix) const {
       solids.begin(), solids.end(), [&](const Primitive& p) { return p.tag.rfind(prefix, 0) == 0; }));
 }
 
+const std::array<const char*, RenderLayers::kCount>& RenderLayers::names() {
+  static const std::array<const char*, kCount> n{"mannequins", "scene", "objects", "contacts", "balance",
+                                                 "control_frames", "overlay"};
+  return n;
+}
+
+bool& RenderLayers::flag(int i) {
+  switch (i) {
+    case 0: return mannequins;
+    case 1: return scene;
+    case 2: return objects;
+    case 3: return contacts;
+    case 4: return balance;
+    case 5: return control_frames;
+    default: return overlay;
+  }
+}
+
+bool RenderLayers::shows(Layer layer) const {
+  switch (layer) {
+    case Layer::kScene: return scene;
+    case Layer::kObject: return objects;
+    case Layer::kMannequin: return mannequins;
+    case Layer::kContact:
+    case Layer::kForce: return contacts;
+    case Layer::kBalance: return balance;
+    case Layer::kControl: return control_frames;
+  }
+  return true;
+}
+
+void applyLayers(RenderScene& scene, const RenderLayers& layers) {
+  std::erase_if(scene.solids, [&](const Primitive& p) { return !layers.shows(p.layer); });
+  std::erase_if(scene.lines, [&](const Polyline& l) { return !layers.shows(l.layer); });
+}
+
 Colour forceColour(double newtons, const Style& style) {
   const double t = style.force_full > 0 ? std::clamp(newtons / style.force_full, 0.0, 1.0) : 1.0;
   // yellow (1, 0.9, 0.1) → red (0.95, 0.1, 0.05)
@@ -232,6 +268,43 @@ RenderScene buildScene(const v1::WorldState& state, const SceneAssets& assets, c
       s.colour = style.com_colour;
       s.tag = "com:" + m.name();
       out.solids.push_back(std::move(s));
+    }
+    // control frames: achieved pose (shaded axes), target (unlit axes lines), error line between them
+    for (const v1::ControlFrameState& cf : m.control_frames()) {
+      const std::string tag = "control:" + m.name() + "/" + cf.frame();
+      const bool has_actual = cf.has_actual(), has_target = cf.has_target();
+      const SE3 actual = toPose(cf.actual()), target = toPose(cf.target());
+      const double L = style.control_axis_length;
+      if (has_actual) {
+        for (int a = 0; a < 3; ++a) {
+          Primitive c;
+          c.kind = Kind::kCylinder;
+          c.layer = Layer::kControl;
+          c.radius = style.control_axis_radius;
+          c.length = L;
+          const Vector3 axis = actual.R.col(a);
+          c.pose = SE3(math::frameAlong(axis), actual.p + 0.5 * L * axis);
+          c.colour = style.control_axis_colours[static_cast<std::size_t>(a)];
+          c.tag = tag;
+          out.solids.push_back(std::move(c));
+        }
+      }
+      if (has_target) {
+        for (int a = 0; a < 3; ++a) {
+          Polyline l;
+          l.layer = Layer::kControl;
+          l.colour = cf.tracked() ? style.control_target_colours[static_cast<std::size_t>(a)] : style.control_untracked_colour;
+          l.points = {target.p, target.p + L * target.R.col(a)};
+          out.lines.push_back(std::move(l));
+        }
+      }
+      if (has_actual && has_target && (target.p - actual.p).norm() > style.control_error_min) {
+        Polyline l;
+        l.layer = Layer::kControl;
+        l.colour = style.control_error_colour;
+        l.points = {actual.p, target.p};
+        out.lines.push_back(std::move(l));
+      }
     }
     const auto hull = convexHull(std::move(support));
     if (hull.size() >= 2) {

@@ -1,5 +1,6 @@
 #include "mannequin/render/view.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <stdexcept>
@@ -8,6 +9,7 @@
 
 #include "mannequin/core/config.hpp"
 #include "mannequin/v1/mocap.pb.h"
+#include "mannequin/v1/world.pb.h"
 
 namespace mannequin::render {
 
@@ -18,7 +20,7 @@ ViewConfig fromNode(const core::ConfigNode& root) {
   ViewConfig v;
   v.source = root.file();
   root.allowOnly({"name", "type", "size", "background", "camera", "wall", "head", "head_body", "head_offset", "near",
-                  "far", "style", "sync", "sync_timeout"});
+                  "far", "style", "sync", "sync_timeout", "layers", "follow", "stereo"});
   if (auto y = root.find("sync")) v.sync = y->boolean();
   v.sync_timeout = root.getIn("sync_timeout", v.sync_timeout, 0.01, 60.0);
   v.name = root.get("name", v.name);
@@ -42,6 +44,28 @@ ViewConfig fromNode(const core::ConfigNode& root) {
     s->allowOnly({"force_scale", "force_full"});
     if (auto f = s->find("force_scale")) v.style.force_scale = f->positive();
     if (auto f = s->find("force_full")) v.style.force_full = f->positive();
+  }
+  if (auto l = root.find("layers")) {
+    if (!l->isMap()) l->fail("expected a map {layer: true|false}");
+    const auto& names = RenderLayers::names();
+    l->allowOnly(std::vector<std::string>(names.begin(), names.end()));
+    for (int i = 0; i < RenderLayers::kCount; ++i)
+      if (auto f = l->find(names[static_cast<std::size_t>(i)])) v.layers.flag(i) = f->boolean();
+  }
+  if (auto f = root.find("follow")) {
+    if (v.type != ViewConfig::Type::kDesktop) f->fail("only a desktop view follows a mannequin (type: desktop)");
+    v.follow = f->str();
+    if (v.follow.empty()) f->fail("expected a mannequin name or index");
+  }
+  if (auto st = root.find("stereo")) {
+    if (v.type != ViewConfig::Type::kWall) st->fail("only a wall view has stereo (type: wall)");
+    st->allowOnly({"eye_separation", "mode"});
+    v.stereo.enabled = true;
+    if (auto e = st->find("eye_separation")) {
+      v.stereo.eye_separation = e->positive();
+      if (v.stereo.eye_separation > 0.5) e->fail("expected metres between the eyes, in (0, 0.5]");
+    }
+    if (auto m = st->find("mode")) (void)m->choice({"side_by_side"});
   }
   if (v.type == ViewConfig::Type::kDesktop) {
     for (const char* k : {"wall", "head", "head_body", "head_offset", "near", "far"})
@@ -75,7 +99,7 @@ ViewConfig fromNode(const core::ConfigNode& root) {
     if (auto t = root.find("far")) v.far_plane = t->positive();
     if (v.far_plane <= v.near_plane) root["far"].fail("far must be greater than near");
     try {
-      (void)wallCamera(v.wall, v.head, v.near_plane, v.far_plane);
+      (void)v.eyes(2, 1);  // the head's camera, or both eyes'
     } catch (const std::invalid_argument& e) {
       w.fail(e.what());
     }
@@ -87,6 +111,15 @@ ViewConfig fromNode(const core::ConfigNode& root) {
 Camera ViewConfig::camera(int image_width, int image_height) const {
   if (type == Type::kWall) return wallCamera(wall, head, near_plane, far_plane);
   return orbit.camera(static_cast<double>(image_width) / std::max(1, image_height));
+}
+
+std::vector<EyeView> ViewConfig::eyes(int image_width, int image_height) const {
+  if (type != Type::kWall || !stereo.enabled) return {EyeView{camera(image_width, image_height), 0, image_width}};
+  const Vec3 vr = (wall.lower_right - wall.lower_left).normalized();
+  const Vec3 half = 0.5 * stereo.eye_separation * vr;
+  const int left = image_width / 2;
+  return {EyeView{wallCamera(wall, head - half, near_plane, far_plane), 0, left},
+          EyeView{wallCamera(wall, head + half, near_plane, far_plane), left, image_width - left}};
 }
 
 std::optional<Vec3> trackedHead(const v1::MocapFrame& frame, const ViewConfig& view) {
@@ -102,6 +135,39 @@ std::optional<Vec3> trackedHead(const v1::MocapFrame& frame, const ViewConfig& v
     return eye;
   }
   return std::nullopt;
+}
+
+std::optional<Vec3> followPoint(const v1::WorldState& state, const std::string& follow) {
+  if (follow.empty()) return std::nullopt;
+  const v1::MannequinState* m = nullptr;
+  for (const v1::MannequinState& c : state.mannequins())
+    if (c.name() == follow) {
+      m = &c;
+      break;
+    }
+  if (m == nullptr && std::all_of(follow.begin(), follow.end(), [](char c) { return c >= '0' && c <= '9'; }) &&
+      follow.size() < 9) {
+    const int i = std::stoi(follow);
+    if (i < state.mannequins_size()) m = &state.mannequins(i);
+  }
+  if (m == nullptr) return std::nullopt;
+  const auto vec = [](const v1::Vec3& p) { return Vec3(p.x(), p.y(), p.z()); };
+  for (const v1::NamedPose& s : m->segments())
+    if (s.name() == "pelvis") return vec(s.pose().position());
+  if (m->segments_size() > 0) return vec(m->segments(0).pose().position());
+  if (m->has_com()) return vec(m->com());
+  return std::nullopt;
+}
+
+OrbitCamera followed(const OrbitCamera& orbit, const v1::WorldState& state, const std::string& follow,
+                     const Eigen::Vector2d& offset) {
+  OrbitCamera out = orbit;
+  const auto p = followPoint(state, follow);
+  if (p && p->allFinite()) {
+    out.target.x() = p->x() + offset.x();
+    out.target.y() = p->y() + offset.y();
+  }
+  return out;
 }
 
 ViewConfig parseView(const std::string& yaml_text, const std::string& source) {

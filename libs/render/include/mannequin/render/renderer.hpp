@@ -20,6 +20,7 @@
 
 #include "mannequin/render/camera.hpp"
 #include "mannequin/render/scene.hpp"
+#include "mannequin/render/view.hpp"
 
 #include "mannequin/render/overlay.hpp"
 
@@ -57,10 +58,19 @@ class Renderer {
   /// Clears the current framebuffer's viewport (0, 0, width, height) to `background` and draws the scene.
   void draw(const RenderScene& scene, const Camera& camera, int width, int height,
             const std::array<float, 3>& background);
+  /// The same into the viewport of columns [x, x + width) and rows [y, y + height) from the BOTTOM (GL's),
+  /// clearing only that rectangle (a stereo eye's half of the image).
+  void draw(const RenderScene& scene, const Camera& camera, int x, int y, int width, int height,
+            const std::array<float, 3>& background);
+  /// Every eye of `eyes` (ViewConfig::eyes) into a height-pixel-high image.
+  void draw(const RenderScene& scene, const std::vector<EyeView>& eyes, int height, const std::array<float, 3>& background);
 
   /// Draws 2D line segments in pixels (rows from the top; see overlay.hpp) over what the framebuffer
   /// holds (no clear, no depth test), in `colour`. Call after draw() with the same size.
   void drawOverlay(const std::vector<Segment2>& segments, int width, int height, const Colour& colour);
+  /// The same in the viewport of columns [x, x + width), all `height` rows (pixels relative to it): a stereo
+  /// eye's half, so that the text is in both eyes' images at the same place (on the screen plane).
+  void drawOverlay(const std::vector<Segment2>& segments, int x, int width, int height, const Colour& colour);
 
   /// GL_RENDERER and GL_VERSION of the current context ("llvmpipe (LLVM 15.0.6, 256 bits) | 4.5 (Core Profile) Mesa ...").
   static std::string describeContext();

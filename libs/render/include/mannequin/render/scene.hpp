@@ -38,7 +38,7 @@ using Colour = std::array<float, 4>;
 enum class Kind { kSphere, kCapsule, kCylinder, kBox, kPlane, kCone, kMesh };
 
 /// What a primitive belongs to (layers, and what pixel tests look for).
-enum class Layer { kScene, kObject, kMannequin, kContact, kForce, kBalance };
+enum class Layer { kScene, kObject, kMannequin, kContact, kForce, kBalance, kControl };
 
 /// One shaded solid, world frame.
 struct Primitive {
@@ -90,6 +90,19 @@ struct Style {
   double support_height = 0.1;      ///< m: pressing contacts with a vertical normal below this span the support polygon
   double plane_extent = 40.0;       ///< m: side of the square a plane is drawn as
   double fallback_segment_radius = 0.05;  ///< m: a segment of a mannequin whose model is unknown
+  /// Control frames (MannequinState.control_frames): the achieved pose as small shaded axes (x, y, z as
+  /// red, green, blue cylinders), the target as unlit axes lines in lighter tints (grey when the frame is not
+  /// tracked), and the error line between their origins in `control_error_colour` (magenta, a hue no other
+  /// layer uses) when they are more than control_error_min apart.
+  double control_axis_length = 0.08;   ///< m
+  double control_axis_radius = 0.004;  ///< m (the achieved pose's axes)
+  std::array<Colour, 3> control_axis_colours{{{0.90f, 0.20f, 0.20f, 1.0f}, {0.20f, 0.80f, 0.25f, 1.0f},
+                                              {0.25f, 0.35f, 0.95f, 1.0f}}};
+  std::array<Colour, 3> control_target_colours{{{1.0f, 0.60f, 0.60f, 1.0f}, {0.60f, 1.0f, 0.60f, 1.0f},
+                                                {0.60f, 0.70f, 1.0f, 1.0f}}};
+  Colour control_untracked_colour{0.55f, 0.55f, 0.55f, 1.0f};
+  Colour control_error_colour{1.0f, 0.20f, 0.85f, 1.0f};
+  double control_error_min = 1e-3;     ///< m: closer target and pose draw no error line
 };
 
 /// The geometry a node needs besides the WorldState: the static scene and the mannequin models.
@@ -116,6 +129,29 @@ struct RenderScene {
   std::size_t countTagged(const std::string& prefix) const;
 };
 
+/// Which layers a view draws (view file `layers:`, window keys 1..7; docs/render.md). The overlay is the
+/// text line (Renderer::drawOverlay), drawn by the node, not part of the RenderScene.
+struct RenderLayers {
+  bool mannequins = true;      ///< kMannequin: segment capsules
+  bool scene = true;           ///< kScene: static bodies (floor, table, ...)
+  bool objects = true;         ///< kObject: movable bodies
+  bool contacts = true;        ///< kContact and kForce: contact points and force arrows
+  bool balance = true;         ///< kBalance: CoM and support polygon
+  bool control_frames = true;  ///< kControl: control frames, targets and error lines
+  bool overlay = false;        ///< the text overlay (also on with --overlay)
+
+  static constexpr int kCount = 7;
+  /// The view-file keys, in key order (key 1 toggles names()[0], ...).
+  static const std::array<const char*, kCount>& names();
+  /// The flag of names()[i], i in [0, kCount).
+  bool& flag(int i);
+  bool flag(int i) const { return const_cast<RenderLayers*>(this)->flag(i); }
+  bool shows(Layer layer) const;
+};
+
+/// Removes the solids and lines of the layers `layers` hides.
+void applyLayers(RenderScene& scene, const RenderLayers& layers);
+
 /// Colour of a force arrow of norm `newtons` (yellow → red over [0, style.force_full]).
 Colour forceColour(double newtons, const Style& style);
 
@@ -134,7 +170,9 @@ RenderScene buildStaticScene(const SceneAssets& assets, const Style& style = {})
 ///   body_a; it is negated when the mannequin's segment "<name>/<segment>" is body_b), length and colour from the norm;
 /// - per mannequin: the CoM (sphere) and the support polygon = the convex hull, projected on z = 0, of its
 ///   pressing contacts (|force| > threshold or normal_force > 0) with a vertical normal (|n_z| > 0.7) lower
-///   than style.support_height (the feet on the floor); drawn as a line 4 mm above z = 0.
+///   than style.support_height (the feet on the floor); drawn as a line 4 mm above z = 0;
+/// - per control frame (layer kControl): `actual` as small shaded axes, `target` as unlit axes lines and,
+///   when they are more than style.control_error_min apart, a line between their origins (see Style).
 RenderScene buildScene(const v1::WorldState& state, const SceneAssets& assets, const Style& style = {});
 
 /// Convex hull (counter-clockwise, no collinear points) of points in the plane, by Andrew's monotone chain.
