@@ -10,6 +10,7 @@
 #include <unistd.h>
 
 #include <Eigen/Geometry>
+#include <GL/gl.h>
 
 #include <algorithm>
 #include <chrono>
@@ -104,6 +105,21 @@ void BM_HeadlessFrame(benchmark::State& state) {
   state.SetLabel(render::Renderer::describeContext());
 }
 BENCHMARK(BM_HeadlessFrame)->Args({1280, 720})->Args({640, 360})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// buildScene + draw + glFinish without the read-back: what the read-back (glReadPixels GL_RGB + row flip)
+// adds to BM_HeadlessFrame is the difference.
+void BM_HeadlessDrawOnly(benchmark::State& state) {
+  const int w = static_cast<int>(state.range(0)), h = static_cast<int>(state.range(1));
+  Fixture f(w, h);
+  const render::Camera cam = f.view.camera(w, h);
+  for (auto _ : state) {
+    const render::RenderScene scene = render::buildScene(f.ws, f.assets, f.view.style);
+    f.renderer->draw(scene, cam, w, h, f.view.background);
+    glFinish();
+  }
+  state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+}
+BENCHMARK(BM_HeadlessDrawOnly)->Args({1280, 720})->Unit(benchmark::kMillisecond)->UseRealTime();
 
 // buildScene alone (no GL): the CPU cost of the scene model per frame.
 void BM_BuildScene(benchmark::State& state) {
