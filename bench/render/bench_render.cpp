@@ -295,8 +295,11 @@ void BM_MocapToPhoton(benchmark::State& state) {
     std::uint64_t last_seq = 0;
     std::size_t unknown = 0, used = 0;
     for (const auto& [step, t] : swaps) {
-      if (t < warm) continue;
       const auto it = refs.find(step);
+      if (t < warm) {  // warm-up: not counted, but its mocap frames were shown already
+        if (it != refs.end()) last_seq = it->second.mocap_sequence;
+        continue;
+      }
       if (it == refs.end()) {
         ++unknown;
         continue;
