@@ -17,6 +17,7 @@
 #include <filesystem>
 #include <fstream>
 #include <map>
+#include <memory>
 #include <thread>
 
 #include "bench_main.hpp"
@@ -212,11 +213,17 @@ struct StateRef {
 // records each sim.world step's FrameRef (the mocap frame it used, with that frame's send time). For every
 // mocap frame that a swap shows, latency = its first swap's time − the frame's send time. window = 0:
 // headless, the swap is the PNG written; window = 1: a window under xvfb-run, the swap is
-// glFinish + glfwSwapBuffers (no PNG). Counters in ms; the first 2 s of swaps (greeting, warm-up) are
-// left out.
+// glFinish + glfwSwapBuffers (no PNG). cave = 1 (headless only): the three synchronised walls of
+// configs/deployments/cave.yaml instead of one node; a step's swap time is the last of the three walls'.
+// Counters in ms; the first 2 s of swaps (greeting, warm-up) are left out.
 void BM_MocapToPhoton(benchmark::State& state) {
   const int w = static_cast<int>(state.range(0)), h = static_cast<int>(state.range(1));
   const bool window = state.range(2) != 0;
+  const bool cave = state.range(3) != 0;
+  if (cave && window) {
+    state.SkipWithError("cave = 1 is headless only");
+    return;
+  }
   const double run_s = 20;
   const fs::path bin = fs::read_symlink("/proc/self/exe").parent_path();
   const fs::path dir = fs::temp_directory_path() / ("bench-render-latency-" + std::to_string(::getpid()));
@@ -228,6 +235,8 @@ void BM_MocapToPhoton(benchmark::State& state) {
     state.SkipWithError("xvfb-run is not installed (tools/setup installs xvfb)");
     return;
   }
+  const std::vector<std::string> names =
+      cave ? std::vector<std::string>{"wall_front", "wall_left", "wall_right"} : std::vector<std::string>{"view"};
   for (auto _ : state) {
     std::map<std::uint64_t, StateRef> refs;
     std::int64_t offset0 = 0, offset1 = 0;
@@ -252,39 +261,53 @@ void BM_MocapToPhoton(benchmark::State& state) {
                        "--name", "collision", "--publish", ipc + "collision", "--connect", ipc + "sim", "--log-level", log});
       Child sim({(bin / "mannequin-sim").string(), "--config", bench::dataFile("configs/sim/sim_demo.yaml"), "--name", "sim",
                  "--publish", ipc + "sim", "--connect", ipc + "mocap", "--connect", ipc + "collision", "--log-level", log});
-      std::vector<std::string> render{(bin / "mannequin-render").string(), "--view", (dir / "view.yaml").string(), "--sim",
-                                      bench::dataFile("configs/sim/sim_demo.yaml"), "--name", "view", "--publish", ipc + "view",
-                                      "--connect", ipc + "sim", "--out", (dir / "frames").string(), "--duration",
-                                      std::to_string(run_s), "--log-level", log};
-      if (window)
-        render.insert(render.begin(), {"xvfb-run", "-a", "-s", "-screen 0 " + std::to_string(w) + "x" + std::to_string(h) + "x24"});
-      else
-        render.insert(render.end(), {"--headless", "--size", std::to_string(w) + "x" + std::to_string(h)});
       // a window takes the view's size: pass it through a view file of that size
       if (window) std::ofstream(dir / "view.yaml") << "type: desktop\nsync: true\nsize: [" << w << ", " << h << "]\n";
       offset0 = wallMinusSteady();
-      Child node(render);
+      std::vector<std::unique_ptr<Child>> nodes;
+      for (const std::string& name : names) {
+        const std::string view = cave ? bench::dataFile("configs/deployments/cave/" + name + ".yaml") : (dir / "view.yaml").string();
+        std::vector<std::string> render{(bin / "mannequin-render").string(), "--view", view, "--sim",
+                                        bench::dataFile("configs/sim/sim_demo.yaml"), "--name", name, "--publish", ipc + name,
+                                        "--connect", ipc + "sim", "--out", (dir / "frames" / name).string(), "--duration",
+                                        std::to_string(run_s), "--log-level", log};
+        for (const std::string& peer : names)
+          if (peer != name) render.insert(render.end(), {"--connect", ipc + peer});
+        if (window)
+          render.insert(render.begin(), {"xvfb-run", "-a", "-s", "-screen 0 " + std::to_string(w) + "x" + std::to_string(h) + "x24"});
+        else
+          render.insert(render.end(), {"--headless", "--size", std::to_string(w) + "x" + std::to_string(h)});
+        nodes.push_back(std::make_unique<Child>(render));
+      }
       const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(run_s + 30);
       bool done = false;
       while (!done && std::chrono::steady_clock::now() < end) {
         sub.poll(std::chrono::milliseconds(10));
-        done = node.wait(0);
+        done = true;
+        for (auto& n : nodes) done = n->wait(0) && done;
       }
       for (int i = 0; i < 20; ++i) sub.poll(std::chrono::milliseconds(5));  // the last states in flight
       offset1 = wallMinusSteady();
-      node.stop(10);
+      for (auto& n : nodes) n->stop(10);
       sim.stop(10);
       collision.stop(10);
       mocap.stop(10);
     }
-    // swaps: "step steady_ns"
-    std::vector<std::pair<std::uint64_t, std::int64_t>> swaps;
-    {
-      std::ifstream in(dir / "frames" / "swaps.log");
+    // swaps: "step steady_ns" per node; a step counts when every node swapped it, at the last node's time
+    std::map<std::uint64_t, std::pair<std::size_t, std::int64_t>> by_step;  // step → (nodes, latest time)
+    for (const std::string& name : names) {
+      std::ifstream in(dir / "frames" / name / "swaps.log");
       std::uint64_t step;
       std::int64_t t;
-      while (in >> step >> t) swaps.emplace_back(step, t);
+      while (in >> step >> t) {
+        auto& e = by_step[step];
+        ++e.first;
+        e.second = std::max(e.second, t);
+      }
     }
+    std::vector<std::pair<std::uint64_t, std::int64_t>> swaps;
+    for (const auto& [step, e] : by_step)
+      if (e.first == names.size()) swaps.emplace_back(step, e.second);
     if (swaps.empty()) {
       state.SkipWithError("the render node logged no swap (see its stderr above)");
       break;
@@ -328,10 +351,11 @@ void BM_MocapToPhoton(benchmark::State& state) {
   fs::remove_all(dir);
 }
 BENCHMARK(BM_MocapToPhoton)
-    ->Args({1280, 720, 0})
-    ->Args({640, 360, 0})
-    ->Args({1280, 720, 1})
-    ->ArgNames({"w", "h", "window"})
+    ->Args({1280, 720, 0, 0})
+    ->Args({640, 360, 0, 0})
+    ->Args({1280, 720, 1, 0})
+    ->Args({640, 640, 0, 1})
+    ->ArgNames({"w", "h", "window", "cave"})
     ->Iterations(1)
     ->Unit(benchmark::kSecond)
     ->UseRealTime();
