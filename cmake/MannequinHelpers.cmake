@@ -39,11 +39,24 @@ function(mannequin_add_test name)
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
+  # gtest_discover_tests flattens its PROPERTIES: a list of labels would break the pairs (the second
+  # label taken for a property name). The first label goes there; a script included after the
+  # discovered tests (their names in ${name}_TESTS) sets them all.
+  set(first_label "")
+  if(ARG_LABELS)
+    list(GET ARG_LABELS 0 first_label)
+  endif()
   gtest_discover_tests(${name}
     DISCOVERY_MODE PRE_TEST
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-    PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT}
+    PROPERTIES LABELS "${first_label}" TIMEOUT ${ARG_TIMEOUT}
     ENVIRONMENT "MANNEQUIN_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+  list(LENGTH ARG_LABELS nlabels)
+  if(nlabels GREATER 1)
+    set(script ${CMAKE_CURRENT_BINARY_DIR}/${name}_labels.cmake)
+    file(WRITE ${script} "foreach(t IN LISTS ${name}_TESTS)\n  set_tests_properties(\"\${t}\" PROPERTIES LABELS \"${ARG_LABELS}\")\nendforeach()\n")
+    set_property(DIRECTORY APPEND PROPERTY TEST_INCLUDE_FILES ${script})
+  endif()
 endfunction()
 
 # mannequin_add_bench(<area> SOURCES ... LIBS ...) -> build/bin/bench-<area>
