@@ -575,3 +575,38 @@ TEST(LemkeWarm, FrictionStructureDegenerateBasis) {
   EXPECT_TRUE(used);
   EXPECT_LE((R.transpose() * (warm.z.head(5) - cold.z.head(5))).norm(), 1e-12);
 }
+
+// a second guess (solveLemkeWarm's overload) is tried when the first fails, before Lemke: the
+// answer's own basis as the second guess answers at once; two wrong guesses fall back to Lemke
+TEST(LemkeWarm, SecondGuessIsTriedBeforeLemke) {
+  const Index n = 30;
+  const auto c = gen::makeContactLike(n, 5);
+  const Eigen::MatrixXd M = c.A * c.A.transpose();
+  const Eigen::VectorXd& q = c.lcp.q;
+  const DenseOperator op(M);
+  LemkeWorkspace ws;
+  LcpResult cold, warm;
+  cold.reserve(n);
+  warm.reserve(n);
+  ASSERT_EQ(solveLemke(op, q, ws, LemkeOptions{}, cold), LcpStatus::Solved) << cold.message;
+  ASSERT_GT(cold.pivots, 0);
+  const std::vector<std::uint8_t> right = basisOf(ws, n);
+  std::vector<std::uint8_t> wrong = right;
+  for (auto& b : wrong) b = b != 0 ? 0 : 1;
+  bool used = false;
+  ASSERT_EQ(solveLemkeWarm(op, q, wrong.data(), right.data(), ws, LemkeOptions{}, warm, &used), LcpStatus::Solved);
+  EXPECT_TRUE(used);
+  EXPECT_EQ(warm.pivots, 0);
+  EXPECT_NE(std::string(warm.message).find("second guess"), std::string::npos) << warm.message;
+  EXPECT_LE((warm.z.head(n) - cold.z.head(n)).lpNorm<Eigen::Infinity>(), 1e-9 * (1.0 + cold.z.lpNorm<Eigen::Infinity>()));
+  EXPECT_EQ(basisOf(ws, n), right);  // the basis kept is the one that answered
+  // the right one first: the second is not needed
+  ASSERT_EQ(solveLemkeWarm(op, q, right.data(), wrong.data(), ws, LemkeOptions{}, warm, &used), LcpStatus::Solved);
+  EXPECT_TRUE(used);
+  EXPECT_NE(std::string(warm.message).find("guessed basis"), std::string::npos) << warm.message;
+  // both wrong: Lemke from the start, same answer
+  ASSERT_EQ(solveLemkeWarm(op, q, wrong.data(), wrong.data(), ws, LemkeOptions{}, warm, &used), LcpStatus::Solved);
+  EXPECT_FALSE(used);
+  EXPECT_EQ(warm.pivots, cold.pivots);
+  EXPECT_LE((warm.w.head(n) - cold.w.head(n)).lpNorm<Eigen::Infinity>(), 1e-8 * (1.0 + q.lpNorm<Eigen::Infinity>()));
+}

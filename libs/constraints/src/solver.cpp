@@ -168,7 +168,9 @@ struct ConstraintSolver::Impl {
   std::vector<std::uint8_t> basic;           // cap_n: the guess for this solve
   std::vector<RowKey> prev_key;              // per row of the previous step
   std::vector<int> prev_pos, prev_neg, prev_edge, prev_gam;  // its LCP layout
-  std::vector<std::uint8_t> prev_basic;      // cap_n: z > 0 in its answer
+  std::vector<std::uint8_t> prev_basic;      // cap_n: basic in its answer (degenerate zeros included)
+  std::vector<double> prev_z;                // cap_n: its answer
+  std::vector<std::uint8_t> basic2;          // cap_n: the second guess (degenerate edges mirrored)
   int prev_nr = 0;
   lcp::LemkeWorkspace lemke;
   lcp::StructuredWorkspace structured;
@@ -236,6 +238,8 @@ ConstraintSolver::ConstraintSolver(std::vector<ConstrainedSystem*> systems, cons
   im.where.assign(static_cast<std::size_t>(im.cap_n), -1);
   im.basic.assign(static_cast<std::size_t>(im.cap_n), 0);
   im.prev_basic.assign(static_cast<std::size_t>(im.cap_n), 0);
+  im.prev_z.assign(static_cast<std::size_t>(im.cap_n), 0.0);
+  im.basic2.assign(static_cast<std::size_t>(im.cap_n), 0);
   im.prev_key.assign(mr, Impl::RowKey{});
   im.prev_pos.assign(mr, -1);
   im.prev_neg.assign(mr, -1);
@@ -303,13 +307,20 @@ const SolveReport& ConstraintSolver::solve(double dt) {
                         rows_.frictionSlot(r) >= 0 ? in.friction_edges : 0, in.source, in.kind};
   };
   // warm start: each row matched to the previous step's row with the same key (producers emit their
-  // rows in a stable order, so a cursor with a short look-ahead finds them), its variables flagged
-  // basic where they were > 0; nullptr when nothing matched (a cold start)
-  const auto guessFromPrevious = [&](int n) -> const std::uint8_t* {
+  // rows in a stable order, so a cursor with a short look-ahead finds them), its variables flagged as
+  // they were in the previous basis; nullptr when nothing matched (a cold start). The second guess
+  // (im.basic2, *second; nullptr when it is the same) mirrors each cone's degenerate basic edges
+  // (β = 0 in the basis) to the opposite edges (k ↔ k + m/2, m even): with a contact at rest, which
+  // of two opposite edges is the degenerate basic one fixes the sign of its sliding speed γ = ∓t_k·v, so
+  // a tangential velocity of 1e-5 m/s that changes sign from one step to the next (a hand at the edge
+  // of its cone) makes the first guess fail by a γ < 0 and the mirrored one right.
+  const auto guessFromPrevious = [&](int n, const std::uint8_t** second) -> const std::uint8_t* {
+    *second = nullptr;
     if (!options_.warm_start || im.prev_nr == 0) return nullptr;
     constexpr int kLookAhead = 8;
     std::fill_n(im.basic.begin(), n, std::uint8_t{0});
-    bool any = false;
+    std::fill_n(im.basic2.begin(), n, std::uint8_t{0});
+    bool any = false, mirrored = false;
     for (int r = 0, c = 0; r < nr; ++r) {
       const Impl::RowKey key = keyOf(r);
       int found = -1;
@@ -334,8 +345,32 @@ const SolveReport& ConstraintSolver::solve(double dt) {
       copy(im.neg[ur], im.prev_neg[uf], 1);
       copy(im.edge[ur], im.prev_edge[uf], key.edges);
       copy(im.gam[ur], im.prev_gam[uf], 1);
+      // the second guess's edges of this row
+      const int m = key.edges;
+      if (im.edge[ur] < 0 || im.prev_edge[uf] < 0) continue;
+      for (int k = 0; k < m; ++k) {
+        const auto from = static_cast<std::size_t>(im.prev_edge[uf] + k);
+        const bool positive = im.prev_basic[from] != 0 && im.prev_z[from] > 0.0;
+        bool degenerate_opposite = false;
+        if (m % 2 == 0) {
+          const auto opp = static_cast<std::size_t>(im.prev_edge[uf] + (k + m / 2) % m);
+          degenerate_opposite = im.prev_basic[opp] != 0 && !(im.prev_z[opp] > 0.0);
+        }
+        const std::uint8_t b2 = positive || degenerate_opposite ? 1 : 0;
+        im.basic2[static_cast<std::size_t>(im.edge[ur] + k)] = b2;
+        mirrored = mirrored || b2 != im.basic[static_cast<std::size_t>(im.edge[ur] + k)];
+      }
     }
-    return any ? im.basic.data() : nullptr;
+    if (!any) return nullptr;
+    if (mirrored) {  // the rest as in the first guess
+      for (int r = 0; r < nr; ++r) {
+        const auto ur = static_cast<std::size_t>(r);
+        for (int i : {im.pos[ur], im.neg[ur], im.gam[ur]})
+          if (i >= 0) im.basic2[static_cast<std::size_t>(i)] = im.basic[static_cast<std::size_t>(i)];
+      }
+      *second = im.basic2.data();
+    }
+    return im.basic.data();
   };
   // steps 2–3 (and 5) — again from the assembly when a refine() added rows
   for (bool assemble = true; assemble;) {
@@ -467,8 +502,9 @@ const SolveReport& ConstraintSolver::solve(double dt) {
     nz = 0;
     n_lcp = n;
     bool warm = false;
-    const lcp::LcpStatus ls =
-        lcp::solveLemkeWarm(M, q, guessFromPrevious(n), im.lemke, options_.lemke, res, &warm);
+    const std::uint8_t* second = nullptr;
+    const std::uint8_t* first = guessFromPrevious(n, &second);
+    const lcp::LcpStatus ls = lcp::solveLemkeWarm(M, q, first, second, im.lemke, options_.lemke, res, &warm);
     rep.lcp_solves += 1;
     rep.warm += warm ? 1 : 0;
     rep.lemke_status = ls;
@@ -597,7 +633,10 @@ const SolveReport& ConstraintSolver::solve(double dt) {
   }
   // Lemke's final basis (degenerate zeros included: without them the guessed block may be singular)
   const std::uint8_t* const basis = im.lemke.basis();
-  for (int i = 0; i < n_lcp; ++i) im.prev_basic[static_cast<std::size_t>(i)] = i < n_kept && basis[i] != 0 ? 1 : 0;
+  for (int i = 0; i < n_lcp; ++i) {
+    im.prev_basic[static_cast<std::size_t>(i)] = i < n_kept && basis[i] != 0 ? 1 : 0;
+    im.prev_z[static_cast<std::size_t>(i)] = i < n_kept ? res.z[i] : 0.0;
+  }
   rep.solve_s = seconds(t2, Clock::now());
   for (std::size_t p = 0; p < producers_.size(); ++p) producers_[p]->solved(static_cast<int>(p), rows_);
   return rep;

@@ -519,16 +519,24 @@ const char* checkOperator(const LcpMatrixOperator& M, const VectorView& q, const
 
 LcpStatus solveLemkeWarm(const LcpMatrixOperator& M, const VectorView& q, const std::uint8_t* basic,
                          LemkeWorkspace& workspace, const LemkeOptions& options, LcpResult& result, bool* warm) {
+  return solveLemkeWarm(M, q, basic, nullptr, workspace, options, result, warm);
+}
+
+LcpStatus solveLemkeWarm(const LcpMatrixOperator& M, const VectorView& q, const std::uint8_t* basic,
+                         const std::uint8_t* second, LemkeWorkspace& workspace, const LemkeOptions& options,
+                         LcpResult& result, bool* warm) {
   if (warm != nullptr) *warm = false;
   if (const char* err = checkOperator(M, q, options, result)) return invalid(result, err);
   workspace.resize(q.size());
-  if (basic != nullptr && q.size() > 0 && tryWarm(M, q, basic, workspace, options, result)) {
-    result.status = LcpStatus::Solved;
-    result.message = "solved (warm start: the guessed basis)";
-    result.pivots = 0;
-    std::copy_n(basic, q.size(), workspace.basis_.begin());
-    if (warm != nullptr) *warm = true;
-    return result.status;
+  for (const std::uint8_t* guess : {basic, second}) {
+    if (guess != nullptr && q.size() > 0 && tryWarm(M, q, guess, workspace, options, result)) {
+      result.status = LcpStatus::Solved;
+      result.message = guess == basic ? "solved (warm start: the guessed basis)" : "solved (warm start: the second guess)";
+      result.pivots = 0;
+      std::copy_n(guess, q.size(), workspace.basis_.begin());
+      if (warm != nullptr) *warm = true;
+      return result.status;
+    }
   }
   return solveViews(M, q, workspace, options, result);
 }

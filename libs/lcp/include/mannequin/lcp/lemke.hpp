@@ -149,5 +149,10 @@ LcpStatus solveLemke(const LcpMatrixOperator& M, const VectorView& q, LemkeWorks
 LcpStatus solveLemkeWarm(const LcpMatrixOperator& M, const VectorView& q, const std::uint8_t* basic,
                          LemkeWorkspace& workspace, const LemkeOptions& options, LcpResult& result,
                          bool* warm = nullptr);
+/// The same with a second guess (may be null), tried when the first fails and before Lemke: e.g. the
+/// first guess with the degenerate choices a caller knows to be two-sided made the other way.
+LcpStatus solveLemkeWarm(const LcpMatrixOperator& M, const VectorView& q, const std::uint8_t* basic,
+                         const std::uint8_t* second, LemkeWorkspace& workspace, const LemkeOptions& options,
+                         LcpResult& result, bool* warm = nullptr);
 
 }  // namespace mannequin::lcp
