@@ -51,6 +51,7 @@ Eigen::ComputationInfo TreeCholesky::compute(const Eigen::Ref<const MatrixX>& b)
     }
     d[k] = std::sqrt(d[k]);
     const int cnt = st[k + 1] - st[k];
+    if (cnt == 0) continue;  // a root (l may be empty: no pointer arithmetic on it)
     double* lk = l + st[k];
     for (int t = 0; t < cnt; ++t) lk[t] /= d[k];
     for (int t = 0; t < cnt; ++t) {
