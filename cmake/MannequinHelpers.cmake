@@ -32,7 +32,9 @@ endfunction()
 # mannequin_add_test(<name> SOURCES ... LIBS ... LABELS ...)
 # One GoogleTest executable; each test case becomes a ctest test carrying LABELS.
 function(mannequin_add_test name)
-  cmake_parse_arguments(ARG "" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  # RUN_SERIAL: no other test runs beside this one's tests (tests that start many processes and whose
+  # timing claims a starved host would break)
+  cmake_parse_arguments(ARG "RUN_SERIAL" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} mannequin_options GTest::gtest GTest::gtest_main)
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin/tests)
@@ -49,7 +51,7 @@ function(mannequin_add_test name)
   gtest_discover_tests(${name}
     DISCOVERY_MODE PRE_TEST
     WORKING_DIRECTORY ${PROJECT_SOURCE_DIR}
-    PROPERTIES LABELS "${first_label}" TIMEOUT ${ARG_TIMEOUT}
+    PROPERTIES LABELS "${first_label}" TIMEOUT ${ARG_TIMEOUT} RUN_SERIAL ${ARG_RUN_SERIAL}
     ENVIRONMENT "MANNEQUIN_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
   list(LENGTH ARG_LABELS nlabels)
   if(nlabels GREATER 1)
