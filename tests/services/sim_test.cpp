@@ -183,7 +183,12 @@ struct MocapFeed {
 // Runs a replay-mode sim service in-process with `cfg` (publish/connect set here), one publisher per
 // feed on its own endpoint (the service connects to all of them), publishes every feed's frames and
 // returns the sim.world payloads once the sim has counted every frame delivered.
-std::vector<std::string> replayRun(simservice::SimServiceConfig cfg, const std::vector<MocapFeed>& feeds, const std::string& dir) {
+// `lockstep`: frame k of every feed is published only once the sim has stepped through every frame
+// before it (the sim's heartbeats, every 10 ms, count them). Without it, the frames of several feeds
+// (several sockets) reach the sim in whatever order the sockets deliver them: all of one feed's first,
+// possibly, and then the other source's mannequin waits uncalibrated while the first one's actor moves.
+std::vector<std::string> replayRun(simservice::SimServiceConfig cfg, const std::vector<MocapFeed>& feeds, const std::string& dir,
+                                   bool lockstep = false) {
   zmq::context_t ctx;
   const std::string sim_ep = "ipc://" + dir + "/sim";
   // the recorded input is byte-identical between runs: no wall-clock send time in it either
@@ -197,7 +202,7 @@ std::vector<std::string> replayRun(simservice::SimServiceConfig cfg, const std::
   cfg.world.interpolation_delay = 0;
   cfg.publish = {sim_ep};
   if (cfg.mocap_sources.empty()) cfg.connect = eps;  // else each source names its endpoint
-  simservice::SimService sim(cfg, ctx);
+  simservice::SimService sim(cfg, ctx, lockstep ? 0.01 : 0.5);
   transport::Subscriber out(ctx, {"test", {sim_ep}});
   std::vector<std::string> worlds;
   out.subscribeRaw("sim.world", [&](std::string_view, std::string_view payload, const transport::Received&) {
@@ -240,15 +245,18 @@ std::vector<std::string> replayRun(simservice::SimServiceConfig cfg, const std::
   if (waitFor([&] { return heartbeat; }, "heartbeat of the sim") &&
       waitFor(subscribed, "subscription of the sim to mocap.frame and collision.contacts of every publisher")) {
     // interleaved by index, as two live systems would send them
+    std::uint64_t sent = 0;
     for (std::size_t k = 0;; ++k) {
       bool any = false;
       for (std::size_t i = 0; i < feeds.size(); ++i)
         if (k < feeds[i].frames.size()) {
           v1::MocapFrame f = feeds[i].frames[k];  // publish() fills the header
           mocap[i]->publish(transport::topics::kMocapFrame, f);
+          ++sent;
           any = true;
         }
       if (!any) break;
+      if (lockstep && !waitFor([&] { return delivered >= sent; }, "heartbeat counting the frames of one index delivered")) break;
     }
     waitFor([&] { return delivered >= total; }, "heartbeat counting every mocap frame delivered");
     EXPECT_EQ(delivered, total);
@@ -375,7 +383,8 @@ TEST(SimConfig, MocapSourcesAreValidated) {
 
 TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {
   // two capture systems (two mocap services "mocap_a" and "mocap_b", each with its own clock: b's
-  // starts at 1000 s) with the same body names; actor a stands at the origin, actor b 3 m away
+  // starts at 1000 s) with the same body names; actor a stands at the origin, actor b 3 m away. The
+  // two feeds go in lockstep, as two live systems running at once would send them (replayRun)
   const std::string dir = tempDir();
   const std::string yaml = "step: 0.001\nworld_rate: 60\nstepper: controller\n"
                            "physics: {enabled: true, scene: configs/scenes/floor.yaml}\n"
@@ -395,7 +404,7 @@ TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {
     a.frames.push_back(actorFrame(k));
     b.frames.push_back(actorFrame(k, at_b, clock_b));
   }
-  const auto worlds = replayRun(cfg, {a, b}, dir);
+  const auto worlds = replayRun(cfg, {a, b}, dir, /*lockstep=*/true);
   std::filesystem::remove_all(dir);
   ASSERT_FALSE(worlds.empty());
   v1::WorldState w;

@@ -473,6 +473,46 @@ TEST(WorldPhysics, TwoMannequinsReachingForTheSamePointStopEachOther) {
   EXPECT_EQ(w.failedSteps(), 0u);
 }
 
+// A mannequin not yet calibrated has no place of its own: it stands where it was built (at the origin,
+// like every other mannequin built there) and touches nothing but the static scene. Alice's actor
+// shows up first, at the origin, where Bob (whose actor has not come yet) also stands: Alice is
+// calibrated there and tracks her actor, no contact pushes the two apart, and Bob stays on the floor.
+// (Were Bob's segments contacts of Alice's, the overlap of two whole bodies would throw Alice off her
+// targets: the sim service's two-source test did so, whenever one source's frames came first.)
+TEST(WorldPhysics, AMannequinNotYetCalibratedTouchesOnlyTheStaticScene) {
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("alice", "rig_a"));
+  setups.push_back(actorSetup("bob", "rig_b"));
+  World w(std::move(setups), physicsConfig("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"));
+  const math::SE3 base = placed(0, 0, 0);
+  const auto feed = [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base), "rig_a"); };
+  feed(0);
+  w.anchor(0, "rig_a");
+  ASSERT_TRUE(w.calibrated(0));
+  ASSERT_FALSE(w.calibrated(1));
+  double between = 0;
+  bool bob_on_floor = true;
+  ASSERT_TRUE(run(w, 0, 1.0, feed, [&](double) {
+    between = std::max(between, forceBetween(w, "alice", "bob"));
+    bob_on_floor = bob_on_floor && w.mannequinDiagnostics(1).foot_contact;
+    return true;
+  }));
+  EXPECT_EQ(between, 0.0) << "contact forces between a calibrated mannequin and one not yet calibrated";
+  bool any_pair = false;
+  const collision::CollisionWorld& cw = *w.collisionWorld();
+  for (const ContactReport& c : w.contacts()) {
+    const std::string& a = cw.bodyName(c.body_a);
+    const std::string& b = cw.bodyName(c.body_b);
+    any_pair = any_pair || (a.rfind("alice/", 0) == 0 && b.rfind("bob/", 0) == 0) ||
+               (a.rfind("bob/", 0) == 0 && b.rfind("alice/", 0) == 0);
+  }
+  EXPECT_FALSE(any_pair) << "contact rows between alice and bob";
+  for (const DrivenFrame& f : w.controlFrames(0))
+    EXPECT_LT(f.position_error, 0.02) << "alice " << f.frame;
+  EXPECT_TRUE(bob_on_floor) << "the uncalibrated mannequin keeps its floor contacts";
+  EXPECT_EQ(w.failedSteps(), 0u);
+}
+
 // Self contacts (physics.self_collision): the two hands of one mannequin driven towards each other in
 // front of the chest, each 4 cm past the midline. Without self contacts they pass through each other and
 // reach their targets; with them the arms push on each other (forces between the mannequin's own

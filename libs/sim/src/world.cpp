@@ -208,6 +208,9 @@ void World::buildPhysics() {
     mo.self_collision = pc.self_collision;
     mo.exclude_pairs = touchingWhenStanding(mp->model, mo, pc.activation_distance);
     P.cw_mannequin.push_back(P.cw.addMannequin(mp->model, mo));
+    // not yet calibrated: no place of its own (it stands where it was built, where the others may
+    // stand too), it touches only the static scene and itself
+    P.cw.setMannequinPlaced(P.cw_mannequin.back(), false);
     P.systems.push_back(std::make_unique<constraints::MannequinSystem>(cs->controller()));
     P.frames.push_back(std::make_unique<constraints::MannequinFrames>(mp->model, cs->controller().data()));
     systems.push_back(P.systems.back().get());
@@ -506,6 +509,11 @@ void World::calibrate(Mannequin& m, const mocap::Frame& frame) {
   }
   std::fill(m.weights.begin(), m.weights.end(), 1.0);
   m.calibrated = true;
+  if (physics_) {
+    std::size_t index = 0;
+    while (mannequins_[index].get() != &m) ++index;
+    physics_->cw.setMannequinPlaced(physics_->cw_mannequin[index], true);
+  }
 }
 
 double World::soleGap(Mannequin& m, const skeleton::VectorX& q) {
@@ -611,12 +619,14 @@ bool World::physicsStep() {
   const auto t1 = Clock::now();
   // contacts at q_k: a query every query_period_steps; in between, the last query's witness points are
   // re-evaluated at q_k by the contact rows
+  diagnostics_.failed_collision_pairs = 0;
   if (steps_ % static_cast<std::uint64_t>(config_.physics.query_period_steps) == 0) {
     for (std::size_t m = 0; m < mannequins_.size(); ++m) {
       auto& cs = static_cast<ControllerStepper&>(*mannequins_[m]->stepper);
       P.cw.updateMannequin(P.cw_mannequin[m], cs.controller().data());
     }
     P.cw.query(steps_, P.set);
+    diagnostics_.failed_collision_pairs = P.set.stats.failed_pairs;
     // a held object and the mannequin holding it: the grasp rows couple them, no contact rows
     bool any_grasp = false;
     for (const Physics::GraspRecord& g : P.grasp_records) any_grasp = any_grasp || g.object >= 0;

@@ -33,11 +33,13 @@ struct SimService::Impl {
   // vectors are sized at construction (nothing allocated per step).
   struct Totals {
     int max_contacts = 0;
+    std::uint64_t failed_pairs = 0;  // collision pairs whose narrow phase failed (summed over steps)
     double contact_sum = 0, max_penetration_m = 0;
     std::uint64_t steps = 0;
     std::vector<double> min_balance;  // per mannequin; NaN: no support in the period
     void reset(int mannequins) {
       max_contacts = 0;
+      failed_pairs = 0;
       contact_sum = 0;
       max_penetration_m = 0;
       steps = 0;
@@ -131,6 +133,7 @@ struct SimService::Impl {
       t->max_contacts = std::max(t->max_contacts, d.contacts);
       t->contact_sum += d.contacts;
       t->max_penetration_m = std::max(t->max_penetration_m, d.max_penetration_m);
+      t->failed_pairs += static_cast<std::uint64_t>(d.failed_collision_pairs);
       for (int m = 0; m < world.numMannequins(); ++m) {
         const double b = world.mannequinDiagnostics(m).balance_distance_m;
         double& mb = t->min_balance[static_cast<std::size_t>(m)];
@@ -147,7 +150,9 @@ struct SimService::Impl {
                                              t.steps > 0 ? t.contact_sum / static_cast<double>(t.steps) : 0.0, t.max_contacts)
                                : fmt::format("contacts mean {:.1f}, max {}",
                                              t.steps > 0 ? t.contact_sum / static_cast<double>(t.steps) : 0.0, t.max_contacts);
-    line += fmt::format(", max penetration {:.2f} mm, balance", t.max_penetration_m * 1e3);
+    line += fmt::format(", max penetration {:.2f} mm", t.max_penetration_m * 1e3);
+    if (t.failed_pairs > 0) line += fmt::format(", {} collision pair tests failed (no contact)", t.failed_pairs);
+    line += ", balance";
     const auto dist = [](double v) { return std::isfinite(v) ? fmt::format("{:.3f} m", v) : std::string("none"); };
     for (int m = 0; m < world.numMannequins(); ++m) {
       line += fmt::format("{} {} ", m > 0 ? "," : "", world.name(m));

@@ -38,6 +38,8 @@ struct QueryStats {
   int broadphase_pairs = 0;  ///< pairs whose inflated AABBs overlap (after filters)
   int pairs_in_range = 0;    ///< pairs with at least one contact
   int triangles_tested = 0;  ///< mesh triangles reached by the BVH traversal
+  int failed_pairs = 0;      ///< pairs whose narrow phase failed (FCL threw, e.g. on two coincident
+                             ///< boxes): no contact is reported for them this query
 };
 
 /// A preallocated set of contacts; CollisionWorld::query clears and refills it (keeping its capacity).

@@ -85,6 +85,12 @@ class CollisionWorld {
   /// Poses a mannequin's segments from data.oMi (call skeleton::forwardKinematics first).
   /// \throws std::invalid_argument for an unknown mannequin or a data of another size.
   void updateMannequin(int mannequin, const skeleton::Data& data);
+  /// Whether a mannequin has a place of its own in the world (default: yes). A mannequin that is not
+  /// placed (sim::World: not yet calibrated to its actor, standing where it was built, where others
+  /// may stand too) pairs only with the static bodies and its own segments.
+  /// \throws std::invalid_argument for an unknown mannequin.
+  void setMannequinPlaced(int mannequin, bool placed);
+  bool mannequinPlaced(int mannequin) const;
   /// Sets a body's margin (m, ≥ 0).
   void setMargin(int body, double margin);
 

@@ -143,6 +143,7 @@ struct StepDiagnostics {
   int contacts = 0;                  ///< contact rows
   int active_contacts = 0;           ///< with λ > 0
   double max_penetration_m = 0.0;    ///< deepest penetration of the real geometry (margins excluded), ≥ 0
+  int failed_collision_pairs = 0;    ///< pairs of this step's collision query (if any) whose narrow phase failed (no contact)
   constraints::SolveReport solver;   ///< rows, LCP size, solver used, pivots, fallback
   bool nan = false;                  ///< a mannequin step produced non-finite numbers (state kept)
   double collision_s = 0, free_motion_s = 0, constraints_s = 0, integrate_s = 0;  ///< wall time per stage
