@@ -31,11 +31,13 @@
 /// - ν'_f = min_i ν'_f_i over the margins and ν_f itself (3.86: the intersection of the polytopes), the
 ///   problem is solved with W' = G (ν'_f, ν_x) (3.88–3.90), and the bias is removed (3.92):
 ///   X_final = X − (ν'_f − ν_f, 0). X_final satisfies G X = W, and its edge forces are ≥ ν_f − ν'_f ≥ 0.
+#include <memory>
 #include <string>
 #include <vector>
 
 #include <Eigen/Dense>
 
+#include "mannequin/balance/balance_qp.hpp"
 #include "mannequin/lcp/lemke.hpp"
 #include "mannequin/math/types.hpp"
 
@@ -93,30 +95,33 @@ struct StaticBalanceResult {
   int pivots = 0;
 };
 
+namespace detail {
+struct Equilibrium;
+}
+
 /// The solver keeps its matrices between solves (sized by the largest problem seen).
 class StaticBalanceSolver {
  public:
   explicit StaticBalanceSolver(const lcp::LemkeOptions& options = {});
+  ~StaticBalanceSolver();
+  StaticBalanceSolver(StaticBalanceSolver&&) noexcept;
+  StaticBalanceSolver& operator=(StaticBalanceSolver&&) noexcept;
   /// Solves one problem; never throws on bad data (kInvalid with a message naming what and where).
   const StaticBalanceResult& solve(const StaticBalanceProblem& problem);
   const StaticBalanceResult& result() const { return result_; }
 
   // -- the matrices of the last solve, for tests and tools --
   /// G (6 × n, n = m_c·m_a + 3) and W (6) of (3.59), with W without the margins' change.
-  const Eigen::MatrixXd& equilibriumMatrix() const { return G_; }
-  const Eigen::VectorXd& equilibriumRhs() const { return W_; }
+  const Eigen::MatrixXd& equilibriumMatrix() const;
+  const Eigen::VectorXd& equilibriumRhs() const;
   /// The unit edge directions a_ik (3 × m_c·m_a, world).
-  const Eigen::MatrixXd& edgeDirections() const { return edges_; }
+  const Eigen::MatrixXd& edgeDirections() const;
 
  private:
-  bool validate(const StaticBalanceProblem& p);
-  void buildEdges(const StaticBalanceProblem& p);
-  lcp::LemkeOptions options_;
-  lcp::LemkeWorkspace ws_;
-  lcp::LcpResult lcp_;
+  BalanceQp qp_;
+  std::unique_ptr<detail::Equilibrium> eq_;
   StaticBalanceResult result_;
-  Eigen::MatrixXd edges_, G_, QAinv_f_, H_, M_, Lt_;
-  Eigen::VectorXd W_, Wm_, Xd_, y_, q_, nu_f_, nu_prime_f_, X_;
+  Eigen::VectorXd X_;
 };
 
 /// Convenience: one solve with a fresh solver.
