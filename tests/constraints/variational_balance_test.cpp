@@ -1,0 +1,259 @@
+// Balance of the whole mannequin, variational form (thesis 3.96–3.107, Algorithm 5, Fig. 3.18): the
+// 50th-percentile male stands with its soles on the floor (4 points each), reaches a wall in front with
+// its left hand, leans on it, and reaches forwards with its right hand while a disturbing-force margin
+// asks for robustness to pushes.
+#include <gtest/gtest.h>
+
+#include <cstdio>
+#include <random>
+
+#include "male50_fixture.hpp"
+#include "mannequin/balance/variational_balance.hpp"
+#include "mannequin/lcp/qp.hpp"
+#include "mannequin/skeleton/anthropometry.hpp"
+#include "mannequin/skeleton/kinematics.hpp"
+
+using namespace mannequin;
+using namespace mannequin::balance;
+using mannequin::testing_fixture::male50;
+
+namespace {
+
+/// 4 points per sole (heel and toe corners, ±4 cm), on the sole frames' joints.
+std::vector<BodyContact> soleContacts(const skeleton::Model& m) {
+  std::vector<BodyContact> out;
+  for (const char* s : {"sole_l", "sole_r"}) {
+    const skeleton::Frame& f = m.frames[static_cast<std::size_t>(m.frameIndex(s))];
+    for (double x : {-0.10, 0.11})
+      for (double y : {-0.04, 0.04}) out.push_back({f.joint, f.placement.act(math::Vector3(x, y, 0)), {0, 0, 1}, 0.6, {0, 0, 0}});
+  }
+  return out;
+}
+
+struct AlgRun {
+  skeleton::VectorX q;
+  int steps = 0, failed = 0;
+  double worst_contact_drift = 0, worst_residual = 0, min_edge_force = 0;
+  VariationalBalanceResult last;
+};
+
+/// Runs Algorithm 5 for `steps` steps (q ← q ⊕ δq), tracking the contacts' world points.
+AlgRun runAlg5(VariationalBalanceProblem p, skeleton::VectorX q, int steps) {
+  const skeleton::Model& m = male50();
+  VariationalBalanceSolver solver(m);
+  skeleton::Data d(m);
+  skeleton::forwardKinematics(m, d, q);
+  std::vector<math::Vector3> start;
+  for (const BodyContact& c : p.contacts) start.push_back(d.oMi[static_cast<std::size_t>(c.joint)].act(c.local_point));
+  AlgRun run;
+  for (int k = 0; k < steps; ++k) {
+    const VariationalBalanceResult& r = solver.solve(p, q);
+    if (r.status != BalanceStatus::kSolved) {
+      ++run.failed;
+      run.last = r;
+      break;
+    }
+    q = skeleton::integrate(m, q, r.dq);
+    skeleton::forwardKinematics(m, d, q);
+    for (std::size_t i = 0; i < p.contacts.size(); ++i)
+      run.worst_contact_drift = std::max(run.worst_contact_drift, (d.oMi[static_cast<std::size_t>(p.contacts[i].joint)].act(p.contacts[i].local_point) - start[i]).norm());
+    run.worst_residual = std::max(run.worst_residual, r.equilibrium_residual);
+    run.min_edge_force = std::min(run.min_edge_force, r.edge_forces.minCoeff());
+    run.last = r;
+    ++run.steps;
+  }
+  run.q = q;
+  return run;
+}
+
+math::Vector3 framePosition(const skeleton::VectorX& q, const char* frame) {
+  skeleton::Data d(male50());
+  skeleton::forwardKinematics(male50(), d, q);
+  return d.oMf[static_cast<std::size_t>(male50().frameIndex(frame))].p;
+}
+
+math::Vector3 comOf(const skeleton::VectorX& q) {
+  skeleton::Data d(male50());
+  skeleton::forwardKinematics(male50(), d, q);
+  return skeleton::centerOfMass(male50(), d);
+}
+
+}  // namespace
+
+// Fig. 3.18. Phase 1: the left hand goes to the wall (a task), the soles stay put. Phase 2: the left
+// hand is a contact on the wall (normal −x), the right hand reaches forwards and down, with and without
+// a margin against ±150 N fore-aft pushes at the CoM. The contact points stay still, the right hand
+// reaches its target, and with the margin the mannequin leans further towards the wall and presses it harder.
+TEST(VariationalBalance, Fig3_18_ContactsStayTheHandReachesTheMarginLeansOnTheWall) {
+  const skeleton::Model& m = male50();
+  const skeleton::VectorX q0 = skeleton::standingConfiguration(m);
+  skeleton::Data d(m);
+  skeleton::forwardKinematics(m, d, q0);
+  const double wall = framePosition(q0, "hand_l").x() + 0.40;
+  VariationalBalanceProblem p1;
+  p1.contacts = soleContacts(m);
+  p1.held = holdCurrentPoses(p1.contacts, d.oMi);
+  const math::Vector3 on_wall(wall, framePosition(q0, "hand_l").y() + 0.05, 1.25);
+  p1.tasks = {{m.frameIndex("hand_l"), on_wall}};
+  const AlgRun reach = runAlg5(p1, q0, 150);
+  ASSERT_EQ(reach.failed, 0) << reach.last.message;
+  std::printf("phase 1: left hand %.4f m from the wall point, soles drifted %.5f m, %d equality rows, LCP %d\n",
+              (framePosition(reach.q, "hand_l") - on_wall).norm(), reach.worst_contact_drift, reach.last.equality_rows,
+              reach.last.lcp_size);
+  ASSERT_LT((framePosition(reach.q, "hand_l") - on_wall).norm(), 0.005);
+  EXPECT_LT(reach.worst_contact_drift, 1e-3);
+
+  // phase 2: the left hand is on the wall
+  skeleton::forwardKinematics(m, d, reach.q);
+  const skeleton::Frame& hl = m.frames[static_cast<std::size_t>(m.frameIndex("hand_l"))];
+  VariationalBalanceProblem p2;
+  p2.contacts = soleContacts(m);
+  p2.contacts.push_back({hl.joint, hl.placement.p, {-1, 0, 0}, 0.6, {0, 0, 0}});
+  p2.held = holdCurrentPoses(p2.contacts, d.oMi);
+  const math::Vector3 reach_r = framePosition(reach.q, "hand_r") + math::Vector3(0.25, -0.05, 0.15);
+  p2.tasks = {{m.frameIndex("hand_r"), reach_r}};
+  const AlgRun plain = runAlg5(p2, reach.q, 200);
+  VariationalBalanceProblem p3 = p2;
+  const math::Vector3 at = comOf(reach.q);
+  for (double sgn : {1.0, -1.0}) {
+    const math::Vector3 force(sgn * 150.0, 0, 0);
+    math::Vector6 D;
+    D << at.cross(force), force;
+    p3.force_margins.push_back(D);
+  }
+  const AlgRun margin = runAlg5(p3, reach.q, 200);
+  for (const AlgRun* r : {&plain, &margin}) {
+    ASSERT_EQ(r->failed, 0) << r->last.message;
+    EXPECT_LT(r->worst_contact_drift, 1e-3) << "contact points stay still";
+    EXPECT_LT((framePosition(r->q, "hand_r") - reach_r).norm(), 0.01) << "the right hand reaches its target";
+    EXPECT_GE(r->min_edge_force, 0.0);
+    // the linearised CoM's equilibrium (3.98) holds to what the linearisation leaves over one step
+    EXPECT_LT(r->worst_residual, 1.0) << "N or N·m";
+  }
+  const double hand_plain = -plain.last.forces.back().x(), hand_margin = -margin.last.forces.back().x();
+  const double com_plain = comOf(plain.q).x(), com_margin = comOf(margin.q).x();
+  std::printf("Fig. 3.18: CoM x %.4f → %.4f m (no margin) / %.4f m (±150 N margin); wall force %.1f / %.1f N; "
+              "contact drift %.5f / %.5f m; right hand error %.4f / %.4f m; LCP %d, pivots %d\n",
+              comOf(reach.q).x(), com_plain, com_margin, hand_plain, hand_margin, plain.worst_contact_drift,
+              margin.worst_contact_drift, (framePosition(plain.q, "hand_r") - reach_r).norm(),
+              (framePosition(margin.q, "hand_r") - reach_r).norm(), margin.last.lcp_size, margin.last.pivots);
+  EXPECT_GT(com_margin, com_plain + 0.005) << "the margin leans the mannequin towards the wall";
+  EXPECT_GT(hand_margin, hand_plain + 1.0) << "and it presses the wall harder";
+}
+
+// BalanceQp with bounds on y against the generic QP→LCP (Annex A) on a random problem: same optimum.
+TEST(VariationalBalance, TheBoundedQpGivesTheGenericQpOptimum) {
+  std::mt19937 rng(11);
+  std::normal_distribution<double> g(0, 1);
+  const int mc = 3, ma = 4, nf = mc * ma, ny = 5, ne = 4, n = nf + ny;
+  BalanceQp qp;
+  qp.contacts = mc;
+  qp.edges = ma;
+  qp.B.resize(nf, ma);
+  for (int i = 0; i < mc; ++i) {
+    Eigen::MatrixXd R(ma, ma);
+    for (int a = 0; a < ma; ++a)
+      for (int b = 0; b < ma; ++b) R(a, b) = g(rng);
+    qp.B.middleRows(i * ma, ma) = R.transpose() * R + Eigen::MatrixXd::Identity(ma, ma);
+  }
+  qp.f_pull.resize(nf);
+  for (int k = 0; k < nf; ++k) qp.f_pull[k] = g(rng);
+  qp.y_weight = Eigen::VectorXd::Constant(ny, 2.0);
+  qp.y_desired.resize(ny);
+  for (int k = 0; k < ny; ++k) qp.y_desired[k] = 3 * g(rng);
+  qp.lower = Eigen::VectorXd::Constant(ny, -0.5);
+  qp.upper = Eigen::VectorXd::Constant(ny, 0.5);
+  qp.lower[1] = -std::numeric_limits<double>::infinity();
+  qp.upper[2] = std::numeric_limits<double>::infinity();
+  qp.C.resize(ne, n);
+  for (int a = 0; a < ne; ++a)
+    for (int b = 0; b < n; ++b) qp.C(a, b) = g(rng);
+  qp.c.resize(ne);
+  for (int a = 0; a < ne; ++a) qp.c[a] = g(rng);
+  ASSERT_EQ(qp.solve(), QpOutcome::kSolved);
+  // generic: min ½XᵀQ_A X − rᵀX = ½‖L X − L⁻ᵀr‖² + const with Q_A = LᵀL... as ½‖A X + b‖²_Q: A = I, Q = Q_A, b = −Q_A⁻¹r
+  Eigen::MatrixXd QA = Eigen::MatrixXd::Zero(n, n);
+  for (int i = 0; i < mc; ++i) QA.block(i * ma, i * ma, ma, ma) = qp.B.middleRows(i * ma, ma);
+  QA.bottomRightCorner(ny, ny) = qp.y_weight.asDiagonal();
+  Eigen::VectorXd rr(n);
+  rr << qp.f_pull, qp.y_weight.cwiseProduct(qp.y_desired);
+  lcp::QpProblem gen;
+  gen.A = Eigen::MatrixXd::Identity(n, n);
+  gen.Q = QA;
+  gen.b = -QA.ldlt().solve(rr);
+  gen.C = qp.C;
+  gen.d = qp.c;
+  std::vector<Eigen::VectorXd> rows;
+  std::vector<double> rhs;
+  for (int k = 0; k < nf; ++k) {  // −f ≤ 0
+    Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+    e[k] = -1;
+    rows.push_back(e);
+    rhs.push_back(0);
+  }
+  for (int j = 0; j < ny; ++j) {
+    if (std::isfinite(qp.lower[j])) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+      e[nf + j] = -1;
+      rows.push_back(e);
+      rhs.push_back(-qp.lower[j]);
+    }
+    if (std::isfinite(qp.upper[j])) {
+      Eigen::VectorXd e = Eigen::VectorXd::Zero(n);
+      e[nf + j] = 1;
+      rows.push_back(e);
+      rhs.push_back(qp.upper[j]);
+    }
+  }
+  gen.E.resize(static_cast<Eigen::Index>(rows.size()), n);
+  gen.f.resize(static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t k = 0; k < rows.size(); ++k) {
+    gen.E.row(static_cast<Eigen::Index>(k)) = rows[k].transpose();
+    gen.f[static_cast<Eigen::Index>(k)] = rhs[k];
+  }
+  const lcp::QpResult res = lcp::solveQpAsLcp(gen);
+  ASSERT_EQ(res.status, lcp::QpStatus::Solved) << res.message;
+  EXPECT_LT((res.X - qp.X()).cwiseAbs().maxCoeff(), 1e-8);
+  EXPECT_LT((qp.C * qp.X() - qp.c).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_GE(qp.X().head(nf).minCoeff(), -1e-12);
+  for (int j = 0; j < ny; ++j) {
+    EXPECT_GE(qp.X()[nf + j], qp.lower[j] - 1e-12) << j;
+    EXPECT_LE(qp.X()[nf + j], qp.upper[j] + 1e-12) << j;
+  }
+  int at_bound = 0;  // the desired y (3σ) lies outside the ±0.5 box: some bounds are active
+  for (int j = 0; j < ny; ++j) at_bound += std::abs(std::abs(qp.X()[nf + j]) - 0.5) < 1e-9;
+  EXPECT_GT(at_bound, 0);
+}
+
+TEST(VariationalBalance, BadProblemsAreNamed) {
+  const skeleton::Model& m = male50();
+  const skeleton::VectorX q = skeleton::standingConfiguration(m);
+  skeleton::Data d(m);
+  skeleton::forwardKinematics(m, d, q);
+  VariationalBalanceSolver s(m);
+  VariationalBalanceProblem p;
+  p.contacts = soleContacts(m);
+  p.held = holdCurrentPoses(p.contacts, d.oMi);
+  ASSERT_EQ(s.solve(p, q).status, BalanceStatus::kSolved) << s.result().message;
+  const auto expect = [&](const VariationalBalanceProblem& bad, const skeleton::VectorX& qq, const std::string& what) {
+    const VariationalBalanceResult& r = s.solve(bad, qq);
+    EXPECT_EQ(r.status, BalanceStatus::kInvalid);
+    EXPECT_NE(r.message.find(what), std::string::npos) << "got: " << r.message;
+  };
+  expect(p, skeleton::VectorX::Zero(3), "q must have");
+  VariationalBalanceProblem b = p;
+  b.held.pop_back();
+  expect(b, q, "is not held");
+  b = p;
+  b.contacts[2].joint = 999;
+  expect(b, q, "contact 2: no joint 999");
+  b = p;
+  b.tasks = {{12345, {0, 0, 1}}};
+  expect(b, q, "task 0: no frame");
+  b = p;
+  b.contacts[5].mu = -1;
+  expect(b, q, "contact 5: mu");
+  b = p;
+  b.max_step = 0;
+  expect(b, q, "max_step");
+}
