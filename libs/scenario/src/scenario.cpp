@@ -410,12 +410,12 @@ class Reader {
       compare(v, c, false);
     } else if (key == "trigger") {
       c.kind = K::kTrigger;
-      ConfigNode name = v;
+      // (no ConfigNode assignment: a YAML::Node's operator= writes into the node it refers to)
       if (v.isMap()) {
         v.allowOnly({"name", "value"});
-        name = v["name"];
         c.trigger_value = v.get("value", std::string());
       }
+      const ConfigNode name = v.isMap() ? v["name"] : v;
       c.trigger = name.str();
       if (s_.triggerIndex(c.trigger) < 0)
         name.fail("unknown trigger '" + c.trigger + "' (triggers: " + join(s_.triggers) + ")");
