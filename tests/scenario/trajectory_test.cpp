@@ -3,6 +3,7 @@
 // setpoints across mode switches (Fig. 4.5).
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "mannequin/control/virtual_mechanism.hpp"
@@ -155,8 +156,9 @@ TEST(Continuity, SetpointVelocityContinuousAcrossSwitches) {
     return SE3(mannequin::math::Matrix3::Identity(), Vector3(-0.3, 0, 1.0) + v_target * (k * dt));
   };
   // allowed |ẍ| per step: 0 where the setpoint is affine in t (the free target; its projection on an axis)
-  std::vector<double> acc(steps + 1, 0.0);
+  std::vector<double> acc(steps + 1, 0.0), acc_rot(steps + 1, 0.0);
   std::vector<Vector3> p;
+  std::vector<mannequin::math::Matrix3> R;
   Vector3 offset_at_switch = Vector3::Zero();
   Observation o;
   o.frames.resize(1);
@@ -168,6 +170,7 @@ TEST(Continuity, SetpointVelocityContinuousAcrossSwitches) {
     if (k == switch2) o.triggers.push_back({"go", ""});
     const StepResult& r = engine.step(o);
     p.push_back(r.frames[0].setpoint.pose.p);
+    R.push_back(r.frames[0].setpoint.pose.R);
     if (k == switch1) {
       ASSERT_EQ(engine.stateName(), "guided");
       // the blend the engine builds: from the setpoint now onto the target's projection on the axis
@@ -175,15 +178,30 @@ TEST(Continuity, SetpointVelocityContinuousAcrossSwitches) {
       Setpoint to{mech.poseAt(mech.project(target(k))), Vector6::Zero()};
       to.twist.tail<3>() = (to.pose.p - mech.poseAt(mech.project(target(k - 1))).p) / dt;
       offset_at_switch = r.frames[0].setpoint.pose.p - to.pose.p;
-      const double a = Blend(r.frames[0].setpoint, to, 0.3).positionAccelerationBound().norm();
-      for (int j = k; j <= k + 301; ++j) acc[static_cast<std::size_t>(j)] = a;
+      const Blend blend(r.frames[0].setpoint, to, 0.3);
+      const double a = blend.positionAccelerationBound().norm();
+      // rotation: R = exp(r) R_new with R_new fixed, ω = Jl(r) ṙ, so |ω̇| ≤ |r̈| + ‖dJl/dr‖ |ṙ|² with
+      // ‖Jl‖ ≤ 1, ‖dJl/dr‖ ≤ 1 and |ṙ| ≤ |r̈|max T
+      const double ar = blend.rotationAccelerationBound().norm();
+      EXPECT_GT(std::acos(std::clamp(((to.pose.R.transpose() * r.frames[0].setpoint.pose.R).trace() - 1) / 2, -1.0, 1.0)),
+                1.5);  // the axis turns the frame by 90°
+      for (int j = k; j <= k + 301; ++j) {
+        acc[static_cast<std::size_t>(j)] = a;
+        acc_rot[static_cast<std::size_t>(j)] = ar + (ar * 0.3) * (ar * 0.3);
+      }
     }
     if (k == switch2) {
       ASSERT_EQ(engine.stateName(), "away");
       // the autonomous trajectory from the setpoint (pose and twist): its position part is this quintic
       const Quintic3 q(r.frames[0].setpoint.pose.p, r.frames[0].setpoint.twist.tail<3>(), Vector3::Zero(),
                        Vector3(0.3, 0.3, 1.5), Vector3::Zero(), Vector3::Zero(), 0.5);
-      for (int j = k; j <= k + 501; ++j) acc[static_cast<std::size_t>(j)] = q.accelerationBound().norm();
+      // its rotation starts at rest (the axis's orientation does not turn): the geodesic with the law,
+      // |ω̇| = |log(R0ᵀR1)| |s''(τ)| / T² ≤ |log(R0ᵀR1)| (10/√3) / T²
+      const double angle = logSO3(r.frames[0].setpoint.pose.R.transpose() * expSO3(Vector3(0, 0, M_PI / 4))).norm();
+      for (int j = k; j <= k + 501; ++j) {
+        acc[static_cast<std::size_t>(j)] = q.accelerationBound().norm();
+        acc_rot[static_cast<std::size_t>(j)] = angle * (10 / std::sqrt(3.0)) / (0.5 * 0.5);
+      }
     }
   }
   // without continuity the first switch would jump by the offset in one step
@@ -194,6 +212,8 @@ TEST(Continuity, SetpointVelocityContinuousAcrossSwitches) {
     const double jump = ((p[k] - p[k - 1]) - (p[k - 1] - p[k - 2])).norm() / dt;
     EXPECT_LE(jump, std::max(acc[k], acc[k - 1]) * dt + 1e-9) << "step " << k;
     worst = std::max(worst, jump);
+    const Vector3 w1 = logSO3(R[k] * R[k - 1].transpose()) / dt, w0 = logSO3(R[k - 1] * R[k - 2].transpose()) / dt;
+    EXPECT_LE((w1 - w0).norm(), std::max(acc_rot[k], acc_rot[k - 1]) * dt + 1e-6) << "step " << k;
   }
   // the largest velocity change in one step is a small fraction of a jump onto the axis (offset / dt)
   EXPECT_LT(worst, 0.01 * offset_at_switch.norm() / dt);

@@ -529,7 +529,7 @@ std::string Condition::describe(const std::vector<FrameRef>& frames, const std::
              (other_frame >= 0 ? fr(other_frame) : object >= 0 ? ob(object) : std::string("point")) + ")" + cmp;
     case Kind::kForce: return "|F " + fr(frame) + "|" + cmp;
     case Kind::kReached: return fr(frame) + " reached" + (pose ? std::string(" pose") : std::string(" goal"));
-    case Kind::kTime: return "t > " + fmt(threshold) + " s";
+    case Kind::kTime: return "t ≥ " + fmt(threshold) + " s";
     case Kind::kObject:
       return ob(object) + "." + objects[static_cast<std::size_t>(object)].values[static_cast<std::size_t>(value_index)] + cmp;
     case Kind::kTrigger: return "trigger " + trigger + (trigger_value.empty() ? "" : "=" + trigger_value);
