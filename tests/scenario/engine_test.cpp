@@ -1,9 +1,10 @@
 // The engine: a transition on each event kind (and not before), boolean combinations, phases and
-// actions, the context stack (interrupt / resume), observation checks.
+// actions, the context stack (interrupt / resume), observation checks, no allocation per step.
 #include <gtest/gtest.h>
 
 #include <string>
 
+#include "../common/alloc_counter.hpp"
 #include "common.hpp"
 #include "mannequin/scenario/engine.hpp"
 
@@ -367,4 +368,30 @@ TEST(ScenarioEngine, Deterministic) {
     ASSERT_EQ(ra.frames[0].setpoint.pose.R, rb.frames[0].setpoint.pose.R);
   }
   EXPECT_EQ(a.stateName(), "drilling");
+}
+
+TEST(ScenarioEngine, NoAllocationPerStepSwitchesIncluded) {
+  const Scenario s = loadScenario(scenario_test::sourceDir() + "/configs/scenarios/drill.yaml");
+  Engine e(s);
+  Observation o = observation(s);
+  o.frames[0].target.p = o.frames[0].pose.p = {0.2, -0.2, 1.2};
+  e.step(o);  // warm-up: the initial state's configure and start
+  int visited[4] = {0, 0, 0, 0};
+  int switches = 0;
+  const long allocations = countAllocations([&] {
+    for (int k = 1; k <= 3000; ++k) {
+      o.time = 1e-3 * k;
+      // the hand walks to the hole at 0.2 m/s, the drill reports 4 cm depth after 1.8 s
+      o.frames[0].target.p.x() = std::min(0.2 + 0.2 * o.time, 0.5);
+      o.objects[0].values[0] = o.time > 1.8 ? 0.04 : 0.0;
+      const StepResult& r = e.step(o);
+      o.frames[0].pose = r.frames[0].setpoint.pose;  // a perfect tracker
+      switches += r.switched;
+      ++visited[e.state()];
+    }
+  });
+  if (allocations < 0) GTEST_SKIP() << "allocation counting is off under AddressSanitizer";
+  EXPECT_EQ(switches, 3);  // approach → drilling → retract → free
+  for (int v : visited) EXPECT_GT(v, 0);
+  EXPECT_EQ(allocations, 0);
 }

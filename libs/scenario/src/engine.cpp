@@ -1,5 +1,6 @@
 #include "mannequin/scenario/engine.hpp"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -52,10 +53,21 @@ Engine::Engine(Scenario scenario) : s_(std::move(scenario)) {
   inside_now_.assign(static_cast<std::size_t>(s_.memory_slots), 0);
   frames_.resize(nf);
   result_.frames.resize(nf);
-  result_.actions.reserve(16);
+  std::size_t entry = 0, exit = 0;
+  for (const auto& st : s_.states) {
+    entry = std::max(entry, st.entry.size());
+    exit = std::max(exit, st.exit.size());
+  }
+  result_.actions.reserve(entry + exit);
   result_.phases.reserve(8);
   stack_.reserve(8);
   last_events_.reserve(4);
+}
+
+std::vector<std::string> Engine::lastEvents() const {
+  std::vector<std::string> labels;
+  for (const Transition* t : last_events_) labels.push_back(t->label);
+  return labels;
 }
 
 std::vector<std::string> Engine::contextStack() const {
@@ -255,7 +267,7 @@ const StepResult& Engine::step(const Observation& obs) {
   if (fired != nullptr) {
     result_.switched = true;
     last_events_.clear();
-    last_events_.push_back(fired->label);
+    last_events_.push_back(fired);
     if (fired->resume) {
       leave(true);
       const Context back = stack_.back();

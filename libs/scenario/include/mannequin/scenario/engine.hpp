@@ -13,7 +13,8 @@
 /// and restarts the suspended one (start only, its time in state kept).
 ///
 /// Deterministic: the same observations give the same outputs. At most one transition fires per step
-/// (interrupts first, then the state's transitions in file order).
+/// (interrupts first, then the state's transitions in file order). No heap allocation in step() after
+/// the first one, switches included (tested), except for copying the names of undeclared triggers.
 #include <string>
 #include <vector>
 
@@ -91,7 +92,7 @@ class Engine {
   /// Suspended states, oldest first (ScenarioState.context_stack).
   std::vector<std::string> contextStack() const;
   /// Labels of the transitions fired at the last switch (ScenarioState.last_events).
-  const std::vector<std::string>& lastEvents() const { return last_events_; }
+  std::vector<std::string> lastEvents() const;
 
  private:
   struct Context {
@@ -122,7 +123,7 @@ class Engine {
   std::vector<char> inside_prev_, inside_now_;
   std::vector<FrameState> frames_;
   std::vector<Context> stack_;
-  std::vector<std::string> last_events_;
+  std::vector<const Transition*> last_events_;  ///< into s_ (no copy per switch)
   StepResult result_;
   int state_ = -1;
   double active_since_ = 0, time_offset_ = 0, time_in_state_ = 0, prev_time_ = 0;
