@@ -351,6 +351,10 @@ TEST(ScenarioEngine, RefusesMismatchedObservations) {
   Machine v("{time: 1}");
   v.obs.objects[0].values.clear();
   EXPECT_THROW(v.step(), std::invalid_argument);
+  Machine t("{time: 1}");
+  t.step();
+  t.obs.time -= 0.02;  // step() adds 0.01: 10 ms back in time
+  EXPECT_THROW(t.step(), std::invalid_argument);
 }
 
 TEST(ScenarioEngine, Deterministic) {

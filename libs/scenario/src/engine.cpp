@@ -206,6 +206,9 @@ const StepResult& Engine::step(const Observation& obs) {
       throw std::invalid_argument("scenario '" + s_.name + "': object '" + s_.objects[i].name + "' has " +
                                   std::to_string(obs.objects[i].values.size()) + " values, expected " +
                                   std::to_string(s_.objects[i].values.size()));
+  if (started_ && !(obs.time >= prev_time_))
+    throw std::invalid_argument("scenario '" + s_.name + "': time went back (" + std::to_string(obs.time) + " s after " +
+                                std::to_string(prev_time_) + " s)");
   result_.switched = false;
   result_.actions.clear();
   result_.phases.clear();

@@ -82,7 +82,8 @@ class Engine {
  public:
   explicit Engine(Scenario scenario);
 
-  /// One step. \throws std::invalid_argument when the observation's sizes do not match the scenario.
+  /// One step. \throws std::invalid_argument when the observation's sizes do not match the scenario or
+  /// its time is earlier than the previous step's (NaN included).
   const StepResult& step(const Observation& obs);
 
   const Scenario& scenario() const { return s_; }
