@@ -149,7 +149,7 @@ class Reader {
         s_.interrupts.push_back(std::move(t));
       }
     }
-    checkResume(root);
+    checkResume();
     warnUnreachable();
   }
 
@@ -344,7 +344,7 @@ class Reader {
   }
 
   // `state` is the state whose transition this is (nullptr for interrupts): kReached's default goal
-  Condition condition(const ConfigNode& n, const State* state, int state_index) {
+  Condition condition(const ConfigNode& n, const State* state) {
     Condition c;
     c.where = n.where();
     if (!n.isMap() || n.keys().size() != 1)
@@ -392,7 +392,6 @@ class Reader {
           v["frame"].fail("frame '" + s_.frames[static_cast<std::size_t>(c.frame)].name() + "' is not autonomous in state '" +
                           state->name + "': give the 'pose' to reach");
       }
-      (void)state_index;
     } else if (key == "time") {
       c.kind = K::kTime;
       c.threshold = v.nonNegative();
@@ -423,10 +422,10 @@ class Reader {
       c.kind = key == "all" ? K::kAll : K::kAny;
       const auto items = v.items();
       if (items.empty()) v.fail("'" + key + "' needs at least one event");
-      for (const ConfigNode& i : items) c.children.push_back(condition(i, state, state_index));
+      for (const ConfigNode& i : items) c.children.push_back(condition(i, state));
     } else if (key == "not") {
       c.kind = K::kNot;
-      c.children.push_back(condition(v, state, state_index));
+      c.children.push_back(condition(v, state));
     } else {
       n.fail("unknown event '" + key + "' (expected inside, outside, enter, leave, distance, force, reached, time, "
              "object, trigger, all, any, not)");
@@ -446,7 +445,7 @@ class Reader {
     t.urgent = n.get("urgent", false);
     if (t.urgent && t.resume) n["urgent"].fail("a resume transition cannot be urgent");
     if (!n.has("when")) n.fail("a transition needs 'when' (the event that fires it)");
-    t.when = condition(n["when"], state, state ? s_.stateIndex(state->name) : -1);
+    t.when = condition(n["when"], state);
     t.label = n.has("name") ? n["name"].str() : t.when.describe(s_.frames, s_.objects);
     return t;
   }
@@ -474,7 +473,7 @@ class Reader {
       for (const ConfigNode& t : ts->items()) st.transitions.push_back(transition(t, &st));
   }
 
-  void checkResume(const ConfigNode& root) const {
+  void checkResume() const {
     bool urgent = !s_.interrupts.empty();
     for (const auto& st : s_.states)
       for (const auto& t : st.transitions) urgent = urgent || t.urgent;
@@ -482,7 +481,7 @@ class Reader {
     for (const auto& st : s_.states)
       for (const auto& t : st.transitions)
         if (t.resume)
-          core::failAt(t.where, root.path().empty() ? "states" : root.path(),
+          core::failAt(t.where, "resume",
                        "'resume' in state '" + st.name + "' but no urgent transition or interrupt pushes a context");
   }
 
