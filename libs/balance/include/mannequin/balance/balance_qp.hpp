@@ -14,9 +14,12 @@
 ///   0 ≤ E Π_G Q_A⁻¹ Eᵀ z + E(Π_G Q_A⁻¹ r + H S⁻¹ c) − e  ⊥  z ≥ 0,   Π_G Q_A⁻¹ = Q_A⁻¹ − H S⁻¹ Hᵀ,
 /// r = (f_pull, w ∘ y_d), then X = Π_G Q_A⁻¹(r + Eᵀz) + H S⁻¹ c. M is symmetric PSD: Lemke's ray termination
 /// proves the constraints infeasible.
+#include <vector>
+
 #include <Eigen/Dense>
 
 #include "mannequin/lcp/lemke.hpp"
+#include "mannequin/lcp/qp.hpp"
 
 namespace mannequin::balance {
 
@@ -39,15 +42,30 @@ class BalanceQp {
   QpOutcome solve();
   const Eigen::VectorXd& X() const { return X_; }
   const lcp::LcpResult& lcp() const { return lcp_; }
-  int lcpSize() const { return static_cast<int>(M_.rows()); }
+  int lcpSize() const { return static_cast<int>(op_.m); }
+  /// The same QP in the LCP library's generic form (Annex A: min ½‖A X + b‖²_Q, C X = d, E X ≤ f with
+  /// A = I, Q = Q_A, b = −Q_A⁻¹r), for comparisons (bench-balance). Allocates.
+  lcp::QpProblem asGenericQp() const;
 
  private:
+  /// M of the LCP by its columns and products (Lemke's product form reads only the entering columns).
+  struct Operator final : lcp::LcpMatrixOperator {
+    const BalanceQp* qp = nullptr;
+    Eigen::Index m = 0;
+    double max_abs = 0;
+    Eigen::Index size() const override { return m; }
+    void column(Eigen::Index j, Eigen::Ref<Eigen::VectorXd> out) const override;
+    void multiply(const lcp::VectorView& z, Eigen::Ref<Eigen::VectorXd> out) const override;
+    double maxAbs() const override { return max_abs; }
+  };
+  Operator op_;
+  std::vector<int> partner_;  // per LCP row: the other bound row of the same y_j (−1: none)
   lcp::LemkeOptions options_;
   lcp::LemkeWorkspace ws_;
   lcp::LcpResult lcp_;
-  Eigen::MatrixXd Binv_, H_, EH_, Lt_, M_, S_;
+  Eigen::MatrixXd Binv_, Cs_, H_, EH_, Lt_, S_;
   Eigen::LLT<Eigen::MatrixXd> S_llt_;
-  Eigen::VectorXd r_, u_, q_, e_, X_;
+  Eigen::VectorXd cs_, r_, u_, q_, e_, X_, scale_;
   std::vector<int> lo_idx_, hi_idx_;
   void applyQAinv(const Eigen::VectorXd& r, Eigen::VectorXd& out) const;
 };

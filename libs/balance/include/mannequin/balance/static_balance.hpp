@@ -109,6 +109,8 @@ class StaticBalanceSolver {
   /// Solves one problem; never throws on bad data (kInvalid with a message naming what and where).
   const StaticBalanceResult& solve(const StaticBalanceProblem& problem);
   const StaticBalanceResult& result() const { return result_; }
+  /// The QP of the last solve (its data; asGenericQp() for comparisons).
+  const BalanceQp& qp() const { return qp_; }
 
   // -- the matrices of the last solve, for tests and tools --
   /// G (6 × n, n = m_c·m_a + 3) and W (6) of (3.59), with W without the margins' change.

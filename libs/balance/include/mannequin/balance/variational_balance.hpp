@@ -91,6 +91,8 @@ class VariationalBalanceSolver {
   /// One step of Algorithm 5 at q. Never throws on bad data: kInvalid names what is wrong.
   const VariationalBalanceResult& solve(const VariationalBalanceProblem& problem, const skeleton::VectorX& q);
   const VariationalBalanceResult& result() const { return result_; }
+  /// The QP of the last solve (its data; asGenericQp() for comparisons).
+  const BalanceQp& qp() const { return qp_; }
 
  private:
   const skeleton::Model* model_;
