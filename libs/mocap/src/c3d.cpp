@@ -187,7 +187,10 @@ C3d parseC3d(std::string_view bytes, const std::string& file) {
   const int param_block = r.u8(0);
   if (param_block < 2) r.fail(0, "bad parameter block pointer " + std::to_string(param_block) + " (the parameters start at block 2 or later)");
   const std::size_t param_start = static_cast<std::size_t>(param_block - 1) * kBlock;
-  r.need(param_start, 4, r.size(), "the parameter section header (block " + std::to_string(param_block) + ")");
+  if (param_start + 4 > r.size()) {
+    r.fail(0, "bad parameter block pointer " + std::to_string(param_block) + ": the parameter section (byte " +
+                  std::to_string(param_start) + ") is past the end of the file (" + std::to_string(r.size()) + " bytes)");
+  }
   const int param_blocks = r.u8(param_start + 2);
   const int proc = r.u8(param_start + 3);
   if (proc < 84 || proc > 86) {
