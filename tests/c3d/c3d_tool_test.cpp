@@ -106,6 +106,10 @@ TEST_F(C3dTool, PointsJsonAtFramesFromBothEnds) {
                    "print(sorted(d.keys(), key=int), len(d['0']), [round(v, 4) for v in d['0']['RFT1']], "
                    "d['0']['LFT1'], 'truncated' in d)"),
             "['0', '250', '449'] 26 [248.5833, 226.8333, 37.4167] None False\n");
+  // a lone negative frame after a space
+  const ToolRun last = run("points " + samplePath("pr") + " --frames -1 --json");
+  ASSERT_EQ(last.status, 0) << last.err;
+  EXPECT_EQ(python(last.out, "print(list(d.keys()), d['449']['RFT1'])"), "['449'] [324.583344, 2248, 33.75]\n");
   // the three formats print the same thing
   EXPECT_EQ(run("points " + samplePath("sr") + " --frames 0,250,-1 --json").out, r.out);
   EXPECT_EQ(run("points " + samplePath("vr") + " --frames 0,250,-1 --json").out, r.out);
