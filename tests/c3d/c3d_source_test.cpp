@@ -14,6 +14,7 @@
 #include "mannequin/core/config.hpp"
 #include "mannequin/mocap/c3d_source.hpp"
 
+#include "samples.hpp"
 namespace fs = std::filesystem;
 namespace mc = mannequin::mocap;
 using mannequin::math::Matrix3;
@@ -21,16 +22,8 @@ using mannequin::math::SE3;
 using mannequin::math::Vector3;
 
 namespace {
-
-std::string sourceDir() {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return root ? root : ".";
-}
-
-std::string samplePath(const std::string& kind) {
-  if (const char* dir = std::getenv("MANNEQUIN_C3D_DATA")) return std::string(dir) + "/sample01_Eb015" + kind + ".c3d";
-  return sourceDir() + "/../shared/data/c3d/sample01_Eb015" + kind + ".c3d";
-}
+using c3dtest::samplePath;
+using c3dtest::sourceDir;
 
 class TempDir {
  public:

@@ -11,18 +11,13 @@
 
 #include "c3d_writer.hpp"
 #include "mannequin/mocap/c3d.hpp"
+#include "samples.hpp"
 
 namespace mc = mannequin::mocap;
 using c3dtest::WriteSpec;
 
 namespace {
-
-// the c3d.org samples live beside the checkout, in ../shared/data/c3d (MANNEQUIN_C3D_DATA overrides)
-std::string samplePath(const std::string& kind) {
-  if (const char* dir = std::getenv("MANNEQUIN_C3D_DATA")) return std::string(dir) + "/sample01_Eb015" + kind + ".c3d";
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return std::string(root ? root : ".") + "/../shared/data/c3d/sample01_Eb015" + kind + ".c3d";
-}
+using c3dtest::samplePath;
 
 std::string readBytes(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

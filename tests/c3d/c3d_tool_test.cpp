@@ -10,9 +10,11 @@
 #include <sstream>
 #include <string>
 
+#include "samples.hpp"
 namespace fs = std::filesystem;
 
 namespace {
+using c3dtest::samplePath;
 
 struct ToolRun {
   int status = -1;
@@ -21,12 +23,6 @@ struct ToolRun {
 };
 
 fs::path toolPath() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "mannequin-c3d"; }
-
-std::string samplePath(const std::string& kind) {
-  if (const char* dir = std::getenv("MANNEQUIN_C3D_DATA")) return std::string(dir) + "/sample01_Eb015" + kind + ".c3d";
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return std::string(root ? root : ".") + "/../shared/data/c3d/sample01_Eb015" + kind + ".c3d";
-}
 
 std::string slurp(const fs::path& p) {
   std::ifstream in(p, std::ios::binary);

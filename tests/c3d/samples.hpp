@@ -1,0 +1,21 @@
+#pragma once
+// The c3d.org sample01 capture shipped in data/c3d/ (PC, SGI and DEC formats of one walk), found from the
+// source tree (MANNEQUIN_SOURCE_DIR, set by ctest; else the working directory); MANNEQUIN_C3D_DATA
+// overrides the folder.
+#include <cstdlib>
+#include <string>
+
+namespace c3dtest {
+
+inline std::string sourceDir() {
+  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
+  return root ? root : ".";
+}
+
+/// kind: "pr" (PC/Intel), "sr" (SGI/MIPS), "vr" (DEC/VAX).
+inline std::string samplePath(const std::string& kind) {
+  if (const char* dir = std::getenv("MANNEQUIN_C3D_DATA")) return std::string(dir) + "/sample01_Eb015" + kind + ".c3d";
+  return sourceDir() + "/data/c3d/sample01_Eb015" + kind + ".c3d";
+}
+
+}  // namespace c3dtest
