@@ -278,6 +278,63 @@ TEST(StaticBalance, InfeasibleRequestsAreReportedAsSuch) {
   EXPECT_EQ(r.status, BalanceStatus::kDegenerate) << r.message;
 }
 
+// A given posture (fix_com): the CoM fixed, only the forces unknown. Fore-aft pushes F at the CoM's height
+// h = 0.95 m: statics says the feet alone hold F up to min(m g (x_toe − x)/h, m g (x − x_heel)/h) (tipping)
+// and μ m g (sliding). The solver's equilibrium is exact (a push 3 % past the bound has no equilibrium,
+// 3 % below has one), and the margin of (3.93–3.95), conservative, stays below the bound, is held for
+// real, and grows as the CoM nears the middle of the feet.
+TEST(StaticBalance, TheForceMarginOfAGivenPostureIsBelowTheTippingBound) {
+  const double h = 0.95, mg = kMass * kG;
+  const std::vector<math::Vector3> fore_aft = {{1, 0, 0}, {-1, 0, 0}};
+  double previous = -1;
+  for (double xc : {-0.03, 0.0, 0.03, 0.075}) {
+    StaticBalanceProblem p = standing(false);
+    p.fix_com = true;
+    p.desired_com = {xc, 0, h};
+    const double bound = std::min({mg * (kToe - xc) / h, mg * (xc - kHeel) / h, 0.6 * mg});
+    const auto push = [&](double F) {
+      StaticBalanceProblem q = p;
+      const math::Vector3 f(F, 0, 0);
+      q.external_wrench << p.desired_com.cross(f), f;
+      return solveStaticBalance(q).status;
+    };
+    const double tip_fwd = mg * (kToe - xc) / h, tip_back = mg * (xc - kHeel) / h;
+    EXPECT_EQ(push(0.97 * tip_fwd), BalanceStatus::kSolved) << xc;
+    EXPECT_EQ(push(1.03 * tip_fwd), BalanceStatus::kInfeasible) << xc;
+    EXPECT_EQ(push(-0.97 * tip_back), BalanceStatus::kSolved) << xc;
+    EXPECT_EQ(push(-1.03 * tip_back), BalanceStatus::kInfeasible) << xc;
+    StaticBalanceSolver s;
+    const ForceMarginResult m = forceMargin(s, p, fore_aft, p.desired_com, 2000.0, 0.5);
+    ASSERT_EQ(m.status, BalanceStatus::kSolved) << m.message;
+    std::printf("CoM x %.3f: force margin %.1f N, tipping/sliding bound %.1f N (%d solves)\n", xc, m.margin_n, bound, m.solves);
+    EXPECT_GT(m.margin_n, 0.0);
+    EXPECT_LE(m.margin_n, bound + 0.5);
+    EXPECT_EQ(push(m.margin_n), BalanceStatus::kSolved);
+    EXPECT_EQ(push(-m.margin_n), BalanceStatus::kSolved);
+    EXPECT_GE(m.margin_n, previous) << "the margin grows as the CoM nears the middle of the feet";
+    previous = m.margin_n;
+  }
+  // the hand on the wall in front holds forward pushes too
+  StaticBalanceProblem p = standing(true);
+  p.fix_com = true;
+  p.desired_com = {0.15, 0, h};
+  StaticBalanceSolver s;
+  const double with_hand = forceMargin(s, p, {{1, 0, 0}}, p.desired_com).margin_n;
+  p = standing(false);
+  p.fix_com = true;
+  p.desired_com = {0.15, 0, h};
+  const double feet_only = forceMargin(s, p, {{1, 0, 0}}, p.desired_com).margin_n;
+  std::printf("forward push margin at CoM x 0.15: %.1f N with the hand on the wall, %.1f N on the feet alone\n", with_hand, feet_only);
+  EXPECT_GT(with_hand, feet_only + 10.0);
+  // a posture that is not balanced has no margin, and says so
+  p.desired_com = {0.5, 0, h};
+  const ForceMarginResult off = forceMargin(s, p, fore_aft, p.desired_com);
+  EXPECT_EQ(off.status, BalanceStatus::kInfeasible);
+  EXPECT_EQ(off.margin_n, 0.0);
+  p.com_margins = {{0.1, 0, 0}};
+  EXPECT_EQ(solveStaticBalance(p).status, BalanceStatus::kInvalid);
+}
+
 TEST(StaticBalance, BadInputIsNamed) {
   const auto expect = [](const StaticBalanceProblem& p, const std::string& what) {
     const StaticBalanceResult r = solveStaticBalance(p);

@@ -92,13 +92,17 @@ void Equilibrium::build(const std::vector<PointContact>& contacts, int ma, doubl
   }
 }
 
-void Equilibrium::margins(const std::vector<math::Vector3>& com_margins, const std::vector<math::Vector6>& force_margins) {
+void Equilibrium::margins(const std::vector<math::Vector3>& com_margins, const std::vector<math::Vector6>& force_margins,
+                          bool com_free, const Eigen::VectorXd* rhs) {
   const Eigen::Index nf = G.cols() - 3;
   if (com_margins.empty() && force_margins.empty()) return;
-  const Eigen::Matrix<double, 6, 6> S0 = G * G.transpose();
+  const Eigen::VectorXd& Wu = rhs != nullptr ? *rhs : W;
+  // G⁺ = Gᵀ(GGᵀ)⁻¹ of the unknowns' columns: G (forces and CoM) or G_f (the CoM given)
+  const Eigen::Matrix<double, 6, 6> S0 = com_free ? Eigen::Matrix<double, 6, 6>(G * G.transpose())
+                                                  : Eigen::Matrix<double, 6, 6>(G.leftCols(nf) * G.leftCols(nf).transpose());
   const Eigen::LLT<Eigen::Matrix<double, 6, 6>> S0_llt(S0);
-  const Eigen::Matrix<double, 6, 1> s0w = S0_llt.solve(Eigen::Matrix<double, 6, 1>(W));
-  nu_f = G.leftCols(nf).transpose() * s0w;  // (G⁺W)_f, G⁺ = Gᵀ(GGᵀ)⁻¹
+  const Eigen::Matrix<double, 6, 1> s0w = S0_llt.solve(Eigen::Matrix<double, 6, 1>(Wu));
+  nu_f = G.leftCols(nf).transpose() * s0w;
   nu_prime_f = nu_f;
   if (!com_margins.empty()) {
     // Π_fx = −G_fᵀ S0⁻¹ G_x, Π_xx = I − G_xᵀ S0⁻¹ G_x; Π_f T (Δx; 0) = Π_fx Π_xx⁺ Δx

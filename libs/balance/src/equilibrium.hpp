@@ -22,8 +22,10 @@ struct Equilibrium {
   /// edges, G, W, f_desired (and Wm = W, ν = 0).
   void build(const std::vector<PointContact>& contacts, int ma, double mass, const math::Vector3& gravity,
              const math::Vector6& external_wrench);
-  /// ν_f = (G⁺W)_f, ν'_f = min(ν_f, ν'_f_i) over the margins (3.83, 3.86, 3.95), W' (3.89).
-  void margins(const std::vector<math::Vector3>& com_margins, const std::vector<math::Vector6>& force_margins);
+  /// ν_f = (G⁺W)_f, ν'_f = min(ν_f, ν'_f_i) over the margins (3.83, 3.86, 3.95), W' (3.89). With
+  /// `com_free` false the CoM is given: the pseudo-inverse is G_f's and `rhs` is W − G_x x_com.
+  void margins(const std::vector<math::Vector3>& com_margins, const std::vector<math::Vector6>& force_margins,
+               bool com_free = true, const Eigen::VectorXd* rhs = nullptr);
   /// B_i = w_f I + α a_iᵀ(I − n nᵀ)a_i stacked (nf × m_a).
   void forceWeights(const std::vector<PointContact>& contacts, int ma, double force_weight, double alpha,
                     Eigen::MatrixXd& B) const;

@@ -37,6 +37,7 @@ const StaticBalanceResult& StaticBalanceSolver::solve(const StaticBalanceProblem
   if (!(p.mass > 0) || !std::isfinite(p.mass)) bad = "mass must be > 0 and finite (got " + detail::num(p.mass) + " kg)";
   else if (!p.desired_com.allFinite()) bad = "desired_com has a NaN or Inf";
   else if (!(p.com_weight > 0) || !std::isfinite(p.com_weight)) bad = "com_weight must be > 0 and finite";
+  else if (p.fix_com && !p.com_margins.empty()) bad = "com_margins need the CoM free (fix_com is set)";
   else bad = detail::validateCommon(p.contacts, p.edges, p.force_weight, p.alpha, p.gravity, p.external_wrench, p.com_margins,
                                     p.force_margins);
   if (!bad.empty()) {
@@ -47,19 +48,31 @@ const StaticBalanceResult& StaticBalanceSolver::solve(const StaticBalanceProblem
   result_.lcp_size = nf;
   detail::Equilibrium& eq = *eq_;
   eq.build(p.contacts, ma, p.mass, p.gravity, p.external_wrench);  // (3.59)
-  eq.margins(p.com_margins, p.force_margins);                      // (3.72–3.95)
+  if (p.fix_com) {
+    // the CoM given: G_f f = W − G_x x_com
+    rhs_ = eq.W - eq.G.rightCols<3>() * p.desired_com;
+    eq.margins(p.com_margins, p.force_margins, false, &rhs_);
+  } else {
+    eq.margins(p.com_margins, p.force_margins);                    // (3.72–3.95)
+  }
 
   // the criterion (3.69) and the LCP (3.70): B_i = w_f I + α a_iᵀ(I − n nᵀ)a_i, the CoM weighted by w_x
   qp_.contacts = mc;
   qp_.edges = ma;
   eq.forceWeights(p.contacts, ma, p.force_weight, p.alpha, qp_.B);
   qp_.f_pull = p.force_weight * eq.f_desired;
-  qp_.y_weight.setConstant(3, p.com_weight);
-  qp_.y_desired = p.desired_com;
-  qp_.lower.setConstant(3, -std::numeric_limits<double>::infinity());
-  qp_.upper.setConstant(3, std::numeric_limits<double>::infinity());
-  qp_.C = eq.G;
-  qp_.c = eq.Wm;
+  const int ny = p.fix_com ? 0 : 3;
+  qp_.y_weight.setConstant(ny, p.com_weight);
+  qp_.y_desired = p.desired_com.head(ny);
+  qp_.lower.setConstant(ny, -std::numeric_limits<double>::infinity());
+  qp_.upper.setConstant(ny, std::numeric_limits<double>::infinity());
+  if (p.fix_com) {
+    qp_.C = eq.G.leftCols(nf);
+    qp_.c = eq.Wm - eq.G.rightCols<3>() * p.desired_com;
+  } else {
+    qp_.C = eq.G;
+    qp_.c = eq.Wm;
+  }
   const QpOutcome out = qp_.solve();
   result_.pivots = qp_.lcp().pivots;
   if (out == QpOutcome::kDegenerate) {
@@ -85,7 +98,7 @@ const StaticBalanceResult& StaticBalanceSolver::solve(const StaticBalanceProblem
   X_.head(nf) -= eq.nu_prime_f - eq.nu_f;
   result_.edge_forces = X_.head(nf).cwiseMax(0.0);  // rounding: −1e-15 is 0
   result_.margin_reserve = eq.nu_f - eq.nu_prime_f;
-  result_.com = X_.tail<3>();
+  result_.com = p.fix_com ? p.desired_com : math::Vector3(X_.tail<3>());
   result_.forces.resize(static_cast<std::size_t>(mc));
   for (int i = 0; i < mc; ++i) result_.forces[static_cast<std::size_t>(i)] = eq.edges.middleCols(i * ma, ma) * result_.edge_forces.segment(i * ma, ma);
   Eigen::VectorXd Xf(n);
@@ -94,6 +107,48 @@ const StaticBalanceResult& StaticBalanceSolver::solve(const StaticBalanceProblem
   result_.status = BalanceStatus::kSolved;
   result_.message = "solved";
   return result_;
+}
+
+ForceMarginResult forceMargin(StaticBalanceSolver& solver, StaticBalanceProblem problem, const std::vector<math::Vector3>& directions,
+                              const math::Vector3& point, double max_force, double tolerance) {
+  ForceMarginResult out;
+  if (!point.allFinite() || !(max_force > 0) || !std::isfinite(max_force) || !(tolerance > 0)) {
+    out.message = "force margin: point must be finite, max_force and tolerance > 0";
+    return out;
+  }
+  for (const math::Vector3& d : directions)
+    if (!d.allFinite() || d.norm() < 1e-9) {
+      out.message = "force margin: a direction is zero or not finite";
+      return out;
+    }
+  const auto feasible = [&](double F) {
+    problem.force_margins.clear();
+    for (const math::Vector3& d : directions) {
+      const math::Vector3 f = F * d.normalized();
+      math::Vector6 D;
+      D << point.cross(f), f;
+      problem.force_margins.push_back(D);
+    }
+    ++out.solves;
+    return solver.solve(problem).status == BalanceStatus::kSolved;
+  };
+  problem.force_margins.clear();
+  ++out.solves;
+  const StaticBalanceResult& base = solver.solve(problem);
+  out.status = base.status;
+  out.message = base.message;
+  if (base.status != BalanceStatus::kSolved) return out;
+  if (feasible(max_force)) {
+    out.margin_n = max_force;
+    return out;
+  }
+  double lo = 0, hi = max_force;  // feasible at lo, not at hi
+  while (hi - lo > tolerance) {
+    const double mid = 0.5 * (lo + hi);
+    (feasible(mid) ? lo : hi) = mid;
+  }
+  out.margin_n = lo;
+  return out;
 }
 
 StaticBalanceResult solveStaticBalance(const StaticBalanceProblem& problem, const lcp::LemkeOptions& options) {

@@ -65,6 +65,9 @@ struct StaticBalanceProblem {
   double force_weight = 1.0;  ///< Q1 on the edge forces (1/N²), > 0
   double com_weight = 1e8;    ///< Q1 on the CoM (1/m²), > 0: 1 mm of CoM error weighs as 10 N of edge force
   double alpha = 0.0;         ///< weight of the tangential forces (3.69), ≥ 0
+  /// The CoM is not an unknown: it is at desired_com (a given posture), and the equilibrium reads
+  /// G_f f = W − G_x x_com; the margins are taken on G_f (ν = G_f⁺W). No CoM-position margins then.
+  bool fix_com = false;
   /// CoM-position margins Δx_i (m, world): balanced even with the CoM moved by each of them (3.82).
   std::vector<math::Vector3> com_margins;
   /// Disturbing-wrench margins D_i (moment about the origin, force; world): balanced even with each one
@@ -123,8 +126,22 @@ class StaticBalanceSolver {
   BalanceQp qp_;
   std::unique_ptr<detail::Equilibrium> eq_;
   StaticBalanceResult result_;
-  Eigen::VectorXd X_;
+  Eigen::VectorXd X_, rhs_;
 };
+
+/// Stability margin in disturbing forces of a posture (3.93–3.95 used as a measure): the largest F ≤ `max_force`
+/// such that `problem` stays solvable with the force margins {F·d_k applied at `point`} for every direction
+/// d_k (unit, world) — e.g. ±x, ±y: pushes at the CoM from any horizontal side. Bisection to `tolerance` N.
+/// The margin machinery is conservative (one solution keeps a reserve for every push), so the true
+/// largest push the contacts can hold is at least this.
+struct ForceMarginResult {
+  BalanceStatus status = BalanceStatus::kInvalid;  ///< of the problem without margins (kSolved: margin below is valid)
+  std::string message;
+  double margin_n = 0.0;  ///< N, 0 when the posture itself is not balanced
+  int solves = 0;
+};
+ForceMarginResult forceMargin(StaticBalanceSolver& solver, StaticBalanceProblem problem, const std::vector<math::Vector3>& directions,
+                              const math::Vector3& point, double max_force = 2000.0, double tolerance = 1.0);
 
 /// Convenience: one solve with a fresh solver.
 StaticBalanceResult solveStaticBalance(const StaticBalanceProblem& problem, const lcp::LemkeOptions& options = {});
