@@ -125,6 +125,43 @@ TEST(WorldPhysics, StandingBalanceDistanceIsPositiveInsideTheFeet) {
   EXPECT_LT(md.com.z(), 1.1);
 }
 
+// The stability margin in disturbing forces (PhysicsConfig::force_margin_period, libs/balance): standing,
+// the largest horizontal push at the CoM the feet hold is positive and below what statics allows — μ m g
+// (sliding) and m g ℓ / h_com with ℓ the farthest support point's horizontal distance from the CoM
+// (tipping about the support's edge); lifted off the floor by its actor, nothing holds it: 0.
+TEST(WorldPhysics, TheForceMarginOfAStandingMannequinIsBelowStaticsBoundsAndZeroInTheAir) {
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("operator", ""));
+  SimConfig cfg = physicsConfig("friction: {default: 0.8}\nbodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n");
+  cfg.physics.force_margin_period = 0.05;
+  World w(std::move(setups), cfg);
+  EXPECT_TRUE(std::isnan(w.mannequinDiagnostics(0).force_margin_n)) << "not evaluated before calibration";
+  const math::SE3 base = placed(0, 0, 0);
+  w.addMocap(actorFrame(0, base));
+  w.anchor(0);
+  ASSERT_TRUE(w.calibrated(0));
+  ASSERT_TRUE(run(w, 0, 1.0, [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base)); }));
+  const MannequinDiagnostics& md = w.mannequinDiagnostics(0);
+  const double mg = male50().totalMass() * 9.81, mu = cfg.physics.scene.default_mu;
+  double reach = 0;  // farthest support contact from the CoM, horizontally
+  for (const ContactReport& c : w.contacts()) reach = std::max(reach, (c.point - md.com).head<2>().norm());
+  std::printf("standing: force margin %.1f N from %d contact points (sliding bound %.0f N, tipping bound %.0f N)\n",
+              md.force_margin_n, md.force_margin_contacts, mu * mg, mg * reach / md.com.z());
+  ASSERT_TRUE(std::isfinite(md.force_margin_n));
+  EXPECT_GE(md.force_margin_contacts, 3);
+  EXPECT_GT(md.force_margin_n, 5.0);
+  EXPECT_LE(md.force_margin_n, mu * mg + 1.0);
+  EXPECT_LE(md.force_margin_n, mg * reach / md.com.z() + 1.0);
+  // the actor jumps: every body 0.4 m up, the mannequin follows and its feet leave the floor
+  const math::SE3 up = placed(0, 0, 0) * math::SE3(math::Matrix3::Identity(), math::Vector3(0, 0, 0.4));
+  ASSERT_TRUE(run(w, 1.0, 0.6, [&](double t) { w.addMocap(actorFrame(ns(t) + 1, up)); }));
+  std::printf("lifted: sole height %.3f m, force margin %.1f N from %d contact points\n", md.sole_height_m, md.force_margin_n,
+              md.force_margin_contacts);
+  ASSERT_GT(md.sole_height_m, w.config().physics.foot_contact_tolerance + 0.005) << "the feet left the floor";
+  EXPECT_EQ(md.force_margin_n, 0.0);
+  EXPECT_EQ(md.force_margin_contacts, 0);
+}
+
 // The shipped table scene in a World with a standing mannequin: its ball (0.45 kg) and tray (0.6 kg)
 // are systems of the step's LCP and rest on the table, the contact forces under each equal to its
 // weight within 1% (Fig. 3.6), and they appear among the World's objects.

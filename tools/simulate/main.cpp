@@ -43,6 +43,9 @@ struct Summary {
   double contact_sum = 0;
   long long foot_contact_steps = 0;
   double min_balance_distance_m = kNaN;  // NaN: never a support polygon
+  double min_force_margin_n = kNaN;      // NaN: never evaluated (physics.force_margin_period 0)
+  double force_margin_sum = 0;
+  long long force_margin_samples = 0;
   double worst_joint_limit_excess_rad = 0;
   double hand_error_sum = 0, foot_error_sum = 0;
   long long hand_samples = 0, foot_samples = 0;
@@ -55,6 +58,9 @@ struct Summary {
   double meanHandError() const { return hand_samples > 0 ? hand_error_sum / static_cast<double>(hand_samples) : kNaN; }
   double meanFootError() const { return foot_samples > 0 ? foot_error_sum / static_cast<double>(foot_samples) : kNaN; }
   double realtimeFactor() const { return wall_s > 0 ? sim_time_s / wall_s : kNaN; }
+  double meanForceMargin() const {
+    return force_margin_samples > 0 ? force_margin_sum / static_cast<double>(force_margin_samples) : kNaN;
+  }
 };
 
 bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
@@ -78,6 +84,11 @@ void accumulate(const sim::World& world, bool ok, Summary& s) {
           (!std::isfinite(s.min_balance_distance_m) || md.balance_distance_m < s.min_balance_distance_m))
         s.min_balance_distance_m = md.balance_distance_m;
       s.worst_joint_limit_excess_rad = std::max(s.worst_joint_limit_excess_rad, md.worst_joint_limit_excess_rad);
+      if (std::isfinite(md.force_margin_n)) {
+        if (!(md.force_margin_n >= s.min_force_margin_n)) s.min_force_margin_n = md.force_margin_n;  // NaN: the first
+        s.force_margin_sum += md.force_margin_n;
+        ++s.force_margin_samples;
+      }
     }
     if (!world.calibrated(m)) continue;
     for (const sim::DrivenFrame& f : world.controlFrames(m)) {
@@ -102,11 +113,13 @@ void printJson(const Summary& s) {
       "{\"frames\": %lld, \"steps\": %lld, \"sim_time_s\": %s, \"wall_s\": %s, \"realtime_factor\": %s, "
       "\"physics\": %s, \"nan_steps\": %lld, \"lcp_failures\": %lld, \"max_penetration_m\": %s, \"max_contacts\": %d, "
       "\"mean_contacts\": %s, \"foot_contact_fraction\": %s, \"min_balance_distance_m\": %s, "
-      "\"worst_joint_limit_excess_rad\": %s, \"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld}\n",
+      "\"worst_joint_limit_excess_rad\": %s, \"min_force_margin_n\": %s, \"mean_force_margin_n\": %s, "
+      "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld}\n",
       s.frames, s.steps, num(s.sim_time_s).c_str(), num(s.wall_s).c_str(), num(s.realtimeFactor()).c_str(),
       s.physics ? "true" : "false", s.nan_steps, s.lcp_failures, num(s.max_penetration_m).c_str(), s.max_contacts,
       num(s.meanContacts()).c_str(), num(s.footContactFraction()).c_str(), num(s.min_balance_distance_m).c_str(),
-      num(s.worst_joint_limit_excess_rad).c_str(), num(s.meanHandError()).c_str(), num(s.meanFootError()).c_str(),
+      num(s.worst_joint_limit_excess_rad).c_str(), num(s.min_force_margin_n).c_str(), num(s.meanForceMargin()).c_str(),
+      num(s.meanHandError()).c_str(), num(s.meanFootError()).c_str(),
       s.worlds);
 }
 
@@ -122,6 +135,11 @@ void printHuman(const Summary& s, const std::string& out) {
       std::printf("balance     min distance %.4f m (signed, > 0: CoM projection inside the support)\n", s.min_balance_distance_m);
     else
       std::printf("balance     no balance distance reported by the World\n");
+    if (std::isfinite(s.min_force_margin_n))
+      std::printf("margin      the largest horizontal push at the CoM held: min %.1f N, mean %.1f N (0: not balanced)\n",
+                  s.min_force_margin_n, s.meanForceMargin());
+    else
+      std::printf("margin      not evaluated (physics.force_margin_period: 0)\n");
     std::printf("limits      worst excess %.4f rad\n", s.worst_joint_limit_excess_rad);
   } else {
     std::printf("physics     off (sim config `physics: {enabled: true, scene: ...}` or --scene turns it on)\n");

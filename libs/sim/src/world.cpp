@@ -1,5 +1,7 @@
 #include "mannequin/sim/world.hpp"
 
+#include "mannequin/balance/static_balance.hpp"
+
 #include <algorithm>
 #include <chrono>
 #include <limits>
@@ -92,6 +94,8 @@ struct World::Physics {
   std::vector<int> body_object;                        // per body: object index or −1
   std::vector<char> body_is_foot;                      // per body: a foot segment ("foot*", "toes*")
   std::vector<char> stepping;                          // per mannequin: stage 1 succeeded this step
+  balance::StaticBalanceSolver margin_solver;          // the force margins (one solver, reused)
+  balance::StaticBalanceProblem margin_problem;
   explicit Physics(const collision::WorldOptions& o) : cw(o) {}
   /// Whether mannequin m holds object o (contacts between them are ignored).
   bool holds(int m, int o) const {
@@ -720,7 +724,49 @@ bool World::physicsStep() {
     md.com = bs.com;
     md.support_points = static_cast<int>(P.support[m].size());
   }
+  if (config_.physics.force_margin_period > 0) {
+    const auto every = static_cast<std::uint64_t>(std::max(1.0, std::round(config_.physics.force_margin_period / dt)));
+    if (steps_ % every == 0) updateForceMargins();
+  }
   return ok;
+}
+
+void World::updateForceMargins() {
+  Physics& P = *physics_;
+  const PhysicsConfig& pc = config_.physics;
+  static const std::vector<math::Vector3> kHorizontal = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
+  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+    MannequinDiagnostics& md = mannequin_diagnostics_[m];
+    if (!mannequins_[m]->calibrated) {
+      md.force_margin_n = std::numeric_limits<double>::quiet_NaN();
+      md.force_margin_contacts = 0;
+      continue;
+    }
+    balance::StaticBalanceProblem& bp = P.margin_problem;
+    bp.contacts.clear();
+    for (const ContactReport& r : contacts_) {
+      const int ma = P.body_mannequin[static_cast<std::size_t>(r.body_a)], mb = P.body_mannequin[static_cast<std::size_t>(r.body_b)];
+      const bool on_a = ma == static_cast<int>(m), on_b = mb == static_cast<int>(m);
+      if (on_a == on_b) continue;  // not this mannequin's, or a self contact
+      const int other = on_a ? r.body_b : r.body_a;
+      if (P.cw.bodyKind(other) != collision::BodyKind::kStatic) continue;  // objects and mannequins move
+      if (!(r.normal_force > 0 || r.distance <= pc.foot_contact_tolerance)) continue;
+      // the normal points from a to b: the scene pushes the mannequin along it when the mannequin is b
+      bp.contacts.push_back({r.point, on_b ? r.normal : math::Vector3(-r.normal), P.contacts->friction(r.body_a, r.body_b), math::Vector3::Zero()});
+    }
+    md.force_margin_contacts = static_cast<int>(bp.contacts.size());
+    if (bp.contacts.empty()) {
+      md.force_margin_n = 0.0;  // nothing holds it
+      continue;
+    }
+    bp.mass = mannequins_[m]->model.totalMass();
+    bp.gravity = pc.gravity;
+    bp.fix_com = true;
+    bp.desired_com = md.com;
+    bp.alpha = 1.0;
+    const balance::ForceMarginResult res = balance::forceMargin(P.margin_solver, bp, kHorizontal, md.com, pc.force_margin_max, 1.0);
+    md.force_margin_n = res.status == balance::BalanceStatus::kSolved ? res.margin_n : 0.0;
+  }
 }
 
 void World::updateSupport() {

@@ -26,7 +26,7 @@ std::string resolvePath(const ConfigNode& node) {
 void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
   ph.allowOnly({"enabled", "gravity", "scene", "segment_margin", "segment_material", "self_collision", "query_period_steps", "activation_distance",
                 "calibration_clearance", "friction_edges", "recovery_speed", "max_rows", "balance_rows",
-                "foot_contact_tolerance", "object_time_constant", "balance_ellipse"});
+                "foot_contact_tolerance", "object_time_constant", "balance_ellipse", "force_margin_period", "force_margin_max"});
   p.enabled = ph.get("enabled", p.enabled);
   if (auto g = ph.find("gravity")) p.gravity = g->vec3();
   if (auto sc = ph.find("scene")) {
@@ -57,6 +57,8 @@ void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
   if (auto be = ph.find("balance_ellipse")) p.balance.inscribed = be->choice({"enclosing", "inscribed"}) == 1;
   p.foot_contact_tolerance = ph.getIn("foot_contact_tolerance", p.foot_contact_tolerance, 0.0, 0.1);
   p.object_time_constant = ph.getIn("object_time_constant", p.object_time_constant, 1e-4, 10.0);
+  p.force_margin_period = ph.getIn("force_margin_period", p.force_margin_period, 0.0, 3600.0);
+  p.force_margin_max = ph.getIn("force_margin_max", p.force_margin_max, 1.0, 1e6);
 }
 
 SimServiceConfig parseSimConfig(const ConfigNode& root) {

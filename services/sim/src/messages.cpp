@@ -125,6 +125,7 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
       ms->set_foot_contact(md.foot_contact);
       ms->set_sole_height(md.sole_height_m);
       ms->set_worst_joint_limit_excess(md.worst_joint_limit_excess_rad);
+      ms->set_force_margin(md.force_margin_n);
       // the World's contacts touching this mannequin's segments (bodies "<name>/<segment>")
       const std::string prefix = world.name(i) + "/";
       for (const sim::ContactReport& k : world.contacts()) {
@@ -145,6 +146,7 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
     }
     ms->set_balance_distance(NAN);
     ms->set_sole_height(NAN);
+    ms->set_force_margin(NAN);
     if (contacts != nullptr)
       for (const v1::Contact& k : contacts->contacts()) {
         if (k.mannequin_a() != world.name(i) && k.mannequin_b() != world.name(i)) continue;

@@ -50,6 +50,11 @@ class ContactRows final : public RowProducer {
   void solved(int id, const RowSet& rows) override;
 
   BodyBinding& binding(int body) { return bindings_.at(body); }
+  /// μ between two bodies (their materials' entry of the table; 0 without friction).
+  double friction(int body_a, int body_b) const {
+    if (options_.mu.size() == 0 || options_.friction_edges == 0) return 0.0;
+    return options_.mu(bindings_.at(static_cast<std::size_t>(body_a)).material, bindings_.at(static_cast<std::size_t>(body_b)).material);
+  }
   const std::vector<collision::Contact>& contacts() const { return contacts_; }
   /// Per contact of contacts(), after the last solve: re-evaluated distance (after margins), normal
   /// force λ (N), friction magnitude (N), world point (midpoint of the witness points).

@@ -94,6 +94,12 @@ struct PhysicsConfig {
   bool balance_rows = false;
   constraints::BalanceOptions balance;
   double foot_contact_tolerance = 0.005;  ///< m between the margin shells: a foot touching the floor
+  /// Stability margin in disturbing forces (thesis 3.93–3.95, libs/balance): every `force_margin_period`
+  /// s (0: never), each calibrated mannequin's largest horizontal push at its CoM (±x, ±y) that its
+  /// touching contacts with the static scene hold, its CoM where it is (MannequinDiagnostics::force_margin_n,
+  /// bisection to 1 N, at most `force_margin_max` N).
+  double force_margin_period = 0.0;
+  double force_margin_max = 1000.0;
   /// τ of the scene's objects without a `time_constant` (s; sim::RigidObject).
   double object_time_constant = 0.05;
   constraints::SolverOptions solver;
@@ -136,6 +142,13 @@ struct MannequinDiagnostics {
   double worst_joint_limit_excess_rad = 0.0;  ///< max over coordinates of how far past a limit (≥ 0)
   math::Vector3 com = math::Vector3::Zero();  ///< centre of mass (world, m) at q_k
   int support_points = 0;           ///< foot–floor contact points of the support region
+  /// The largest horizontal push at the CoM (N, any of ±x, ±y) the mannequin's touching contacts with
+  /// the static scene hold with its CoM where it is (balance::forceMargin, multi-contact and non-coplanar:
+  /// hands on a wall count); 0 when the posture itself has no static equilibrium (in the air, leaning
+  /// out); NaN when not evaluated (PhysicsConfig::force_margin_period 0, or not calibrated). Kept
+  /// between evaluations.
+  double force_margin_n = std::numeric_limits<double>::quiet_NaN();
+  int force_margin_contacts = 0;    ///< touching contact points the last evaluation used
 };
 
 /// What the last step did (thesis Alg. 4 stages), for callers and sim.world.
@@ -244,6 +257,7 @@ class World {
   Source* findSource(const std::string& name);
   const Source* findSource(const std::string& name) const;
   void calibrate(Mannequin& m, const mocap::Frame& frame);
+  void updateForceMargins();
   void updateSupport();
   void fillDiagnostics();
   void buildPhysics();
