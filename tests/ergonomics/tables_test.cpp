@@ -114,18 +114,18 @@ TEST(Tables, AWorsePartNeverLowersTheResult) {
       for (int w = 1; w <= 4; ++w)
         for (int t = 1; t <= 2; ++t) {
           const int v = rulaTableA(u, l, w, t);
-          if (u < 6) EXPECT_LE(v, rulaTableA(u + 1, l, w, t)) << u << l << w << t;
-          if (l < 3) EXPECT_LE(v, rulaTableA(u, l + 1, w, t)) << u << l << w << t;
-          if (w < 4) EXPECT_LE(v, rulaTableA(u, l, w + 1, t)) << u << l << w << t;
-          if (t < 2) EXPECT_LE(v, rulaTableA(u, l, w, t + 1)) << u << l << w << t;
+          if (u < 6) { EXPECT_LE(v, rulaTableA(u + 1, l, w, t)) << u << l << w << t; }
+          if (l < 3) { EXPECT_LE(v, rulaTableA(u, l + 1, w, t)) << u << l << w << t; }
+          if (w < 4) { EXPECT_LE(v, rulaTableA(u, l, w + 1, t)) << u << l << w << t; }
+          if (t < 2) { EXPECT_LE(v, rulaTableA(u, l, w, t + 1)) << u << l << w << t; }
         }
   for (int n = 1; n <= 6; ++n)
     for (int t = 1; t <= 6; ++t)
       for (int g = 1; g <= 2; ++g) {
         const int v = rulaTableB(n, t, g);
-        if (n < 6) EXPECT_LE(v, rulaTableB(n + 1, t, g));
-        if (t < 6) EXPECT_LE(v, rulaTableB(n, t + 1, g));
-        if (g < 2) EXPECT_LE(v, rulaTableB(n, t, g + 1));
+        if (n < 6) { EXPECT_LE(v, rulaTableB(n + 1, t, g)); }
+        if (t < 6) { EXPECT_LE(v, rulaTableB(n, t + 1, g)); }
+        if (g < 2) { EXPECT_LE(v, rulaTableB(n, t, g + 1)); }
       }
   for (int c = 1; c <= 9; ++c)
     for (int d = 1; d <= 8; ++d) {
@@ -136,17 +136,17 @@ TEST(Tables, AWorsePartNeverLowersTheResult) {
     for (int n = 1; n <= 3; ++n)
       for (int g = 1; g <= 4; ++g) {
         const int v = rebaTableA(t, n, g);
-        if (t < 5) EXPECT_LE(v, rebaTableA(t + 1, n, g));
-        if (n < 3) EXPECT_LE(v, rebaTableA(t, n + 1, g));
-        if (g < 4) EXPECT_LE(v, rebaTableA(t, n, g + 1));
+        if (t < 5) { EXPECT_LE(v, rebaTableA(t + 1, n, g)); }
+        if (n < 3) { EXPECT_LE(v, rebaTableA(t, n + 1, g)); }
+        if (g < 4) { EXPECT_LE(v, rebaTableA(t, n, g + 1)); }
       }
   for (int u = 1; u <= 6; ++u)
     for (int l = 1; l <= 2; ++l)
       for (int w = 1; w <= 3; ++w) {
         const int v = rebaTableB(u, l, w);
-        if (u < 6) EXPECT_LE(v, rebaTableB(u + 1, l, w)) << u << l << w;
-        if (l < 2) EXPECT_LE(v, rebaTableB(u, l + 1, w)) << u << l << w;
-        if (w < 3) EXPECT_LE(v, rebaTableB(u, l, w + 1)) << u << l << w;
+        if (u < 6) { EXPECT_LE(v, rebaTableB(u + 1, l, w)) << u << l << w; }
+        if (l < 2) { EXPECT_LE(v, rebaTableB(u, l + 1, w)) << u << l << w; }
+        if (w < 3) { EXPECT_LE(v, rebaTableB(u, l, w + 1)) << u << l << w; }
       }
   for (int a = 1; a <= 12; ++a)
     for (int b = 1; b <= 12; ++b) {
