@@ -248,6 +248,37 @@ TEST(Rula, AbductedRaisedArmOutToTheSide) {
   EXPECT_EQ(f.eval.evaluate(q, in).rula[L].upper_arm, 4);
 }
 
+// Wrist: deviation (radial + on both sides, 15° > 10°) gives RULA wrist 1 + 1 = 2 and REBA wrist 1 + 1 = 2;
+// forearm rotation near an end of its 0–160° range (150°) gives RULA twist 2 and REBA's wrist +1, the
+// middle half (40–120°) twist 1. Upper arm extended 40°: RULA/REBA upper arm 2 (extension > 20°).
+TEST(Rula, WristDeviationTwistAndArmExtension) {
+  Fixture f;
+  sk::VectorX q = f.relaxed();
+  f.set(q, "wrist_deviation_l", 15);
+  f.set(q, "wrist_deviation_r", 15);
+  f.set(q, "shoulder_r.y", 40);  // extension is +y
+  Assessment a = f.eval.evaluate(q);
+  for (int s : {L, R}) {
+    EXPECT_NEAR(a.angles.arm[s].wrist_deviation_deg, 15.0, 1e-9);
+    EXPECT_NEAR(a.angles.arm[s].wrist_flexion_deg, 0.0, 1e-9);
+    EXPECT_EQ(a.rula[s].wrist_base, 1);
+    EXPECT_EQ(a.rula[s].wrist, 2);
+    EXPECT_EQ(a.reba[s].wrist, 2);
+  }
+  EXPECT_NEAR(a.angles.arm[R].upper_arm_flexion_deg, -40.0, 1e-9);
+  EXPECT_EQ(a.rula[R].upper_arm, 2);
+  EXPECT_EQ(a.reba[R].upper_arm, 2);
+  q = f.relaxed();
+  f.set(q, "radioulnar_l", 150);
+  f.set(q, "radioulnar_r", 110);
+  a = f.eval.evaluate(q);
+  EXPECT_NEAR(a.angles.arm[L].forearm_rotation_deg, 150.0, 1e-9);
+  EXPECT_EQ(a.rula[L].wrist_twist, 2);
+  EXPECT_EQ(a.reba[L].wrist, 2);
+  EXPECT_EQ(a.rula[R].wrist_twist, 1);
+  EXPECT_EQ(a.reba[R].wrist, 1);
+}
+
 // Hand reaching across the body: shoulder flexed 45° and adducted 30°, elbow 90°: the wrist crosses the
 // midsagittal plane → lower arm 1 + 1 = 2.
 TEST(Rula, AcrossTheMidline) {
@@ -383,6 +414,18 @@ TEST(Scores, PartBandsAtTheirEdges) {
   EXPECT_EQ(rulaTrunkBase(10, 5), 2);
   EXPECT_EQ(rulaTrunkBase(30, 5), 3);
   EXPECT_EQ(rulaTrunkBase(61, 5), 4);
+  EXPECT_EQ(rulaTrunkBase(20, 5), 2);
+  EXPECT_EQ(rulaTrunkBase(21, 5), 3);
+  EXPECT_EQ(rulaTrunkBase(60, 5), 3);
+  EXPECT_EQ(rulaTrunkBase(-10, 5), 2);
+  EXPECT_EQ(rulaNeckBase(20, 5), 2);
+  EXPECT_EQ(rulaNeckBase(-5, 5), 1);
+  EXPECT_EQ(rulaWristBase(15, 5), 2);
+  EXPECT_EQ(rebaTrunkBase(20, 5), 2);
+  EXPECT_EQ(rebaTrunkBase(21, 5), 3);
+  EXPECT_EQ(rebaTrunkBase(60, 5), 3);
+  EXPECT_EQ(rebaTrunkBase(-20, 5), 2);
+  EXPECT_EQ(rebaKneeAdjustment(60), 1);
   EXPECT_EQ(rebaTrunkBase(0, 5), 1);
   EXPECT_EQ(rebaTrunkBase(-10, 5), 2);
   EXPECT_EQ(rebaTrunkBase(-25, 5), 3);
