@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "mannequin/core/main.hpp"
+#include "mannequin/core/text.hpp"
 #include "mannequin/skeleton/bvh.hpp"
 
 namespace sk = mannequin::skeleton;
@@ -27,50 +28,19 @@ struct UsageError : std::runtime_error {
 };
 
 /// A JSON string literal.
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
-/// A JSON number with 9 significant digits (null if not finite).
-std::string num(double v) {
-  if (!std::isfinite(v)) return "null";
-  if (v == 0.0) v = 0.0;  // no "-0"
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+using mannequin::core::jsonString;
+std::string num(double v) { return mannequin::core::jsonNumber(v, 9); }
 
 /// Parses "0,100,-1" into resolved, de-duplicated frame indices (order kept).
 std::vector<int> parseFrames(const sk::Bvh& bvh, const std::string& list) {
   std::vector<int> frames;
-  std::size_t start = 0;
-  while (start <= list.size()) {
-    const std::size_t comma = std::min(list.find(',', start), list.size());
-    const std::string item = list.substr(start, comma - start);
-    long long value = 0;
-    std::size_t used = 0;
-    try {
-      value = std::stoll(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (item.empty() || used != item.size()) {
-      throw UsageError("--frames: expected a comma-separated list of integers, got '" + item + "'");
-    }
+  std::vector<long long> values;
+  try {
+    values = mannequin::core::parseIntegerList(list);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--frames: ") + e.what());
+  }
+  for (const long long value : values) {
     int f = 0;
     try {
       f = sk::resolveBvhFrame(bvh, value);
@@ -78,7 +48,6 @@ std::vector<int> parseFrames(const sk::Bvh& bvh, const std::string& list) {
       throw UsageError(std::string("--frames: ") + e.what());
     }
     if (std::find(frames.begin(), frames.end(), f) == frames.end()) frames.push_back(f);
-    start = comma + 1;
   }
   return frames;
 }

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "mannequin/core/main.hpp"
+#include "mannequin/core/text.hpp"
 #include "mannequin/mocap/c3d.hpp"
 
 namespace mc = mannequin::mocap;
@@ -27,50 +28,19 @@ struct UsageError : std::runtime_error {
   using std::runtime_error::runtime_error;
 };
 
-std::string jsonString(const std::string& s) {
-  std::string out = "\"";
-  for (const char ch : s) {
-    const auto c = static_cast<unsigned char>(ch);
-    if (c == '"' || c == '\\') {
-      out += '\\';
-      out += ch;
-    } else if (c < 0x20 || c >= 0x7f) {  // control bytes, and bytes that may not be UTF-8
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      out += buf;
-    } else {
-      out += ch;
-    }
-  }
-  return out + "\"";
-}
-
-/// A JSON number with 9 significant digits (null if not finite).
-std::string num(double v) {
-  if (!std::isfinite(v)) return "null";
-  if (v == 0.0) v = 0.0;  // no "-0"
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.9g", v);
-  return buf;
-}
+std::string jsonString(const std::string& s) { return mannequin::core::jsonString(s, true); }
+std::string num(double v) { return mannequin::core::jsonNumber(v, 9); }
 
 /// Parses "0,250,-1" into resolved, de-duplicated frame indices (order kept).
 std::vector<int> parseFrames(const mc::C3d& c3d, const std::string& list) {
   std::vector<int> frames;
-  std::size_t start = 0;
-  while (start <= list.size()) {
-    const std::size_t comma = std::min(list.find(',', start), list.size());
-    const std::string item = list.substr(start, comma - start);
-    long long value = 0;
-    std::size_t used = 0;
-    try {
-      value = std::stoll(item, &used);
-    } catch (const std::exception&) {
-      used = 0;
-    }
-    if (item.empty() || used != item.size()) {
-      throw UsageError("--frames: expected a comma-separated list of integers, got '" + item + "'");
-    }
+  std::vector<long long> values;
+  try {
+    values = mannequin::core::parseIntegerList(list);
+  } catch (const std::invalid_argument& e) {
+    throw UsageError(std::string("--frames: ") + e.what());
+  }
+  for (const long long value : values) {
     int f = 0;
     try {
       f = mc::resolveC3dFrame(c3d, value);
@@ -78,7 +48,6 @@ std::vector<int> parseFrames(const mc::C3d& c3d, const std::string& list) {
       throw UsageError(c3d.file + ": --frames: " + e.what() + (c3d.truncated ? " (the file is truncated)" : ""));
     }
     if (std::find(frames.begin(), frames.end(), f) == frames.end()) frames.push_back(f);
-    start = comma + 1;
   }
   return frames;
 }
