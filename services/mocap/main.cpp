@@ -11,7 +11,7 @@
 using namespace mannequin;
 
 int main(int argc, char** argv) {
-  service::Cli cli{"mannequin-mocap: motion-capture service. Reads a source (BVH file, synthetic trajectories,\n"
+  service::Cli cli{"mannequin-mocap: motion-capture service. Reads a source (BVH file, C3D lab capture, synthetic trajectories,\n"
                    "ART DTrack2 UDP ASCII) and publishes mocap.frame (rigid bodies in the room frame, capture\n"
                    "timestamps) and health.heartbeat."};
   service::CommonOptions& common = cli.options;
@@ -31,7 +31,7 @@ int main(int argc, char** argv) {
       if (rate > 0) raw["bvh"]["rate"] = rate;
       if (loop || no_loop) raw["bvh"]["loop"] = !no_loop;
     });
-    config.allowOnly({"name", "publish", "source", "bvh", "synthetic", "dtrack2"});
+    config.allowOnly({"name", "publish", "source", "bvh", "c3d", "synthetic", "dtrack2"});
     const service::Endpoints ep = service::resolveEndpoints(common, config, "mocap");
     std::unique_ptr<mocap::Source> source = mocap::makeSource(config);
     zmq::context_t context;

@@ -6,7 +6,9 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <map>
 
+#include "mannequin/core/paths.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/mocap/bvh_source.hpp"
 #include "mannequin/mocap/dtrack2.hpp"
@@ -235,6 +237,39 @@ TEST(MocapConfig, ShippedFilesAreFoundFromAnotherWorkingDirectory) {
   EXPECT_NE(error.find("test.yaml:3: field 'bvh.file': data/bvh/nothing_here.bvh: not found"), std::string::npos) << error;
 }
 
+// The shipped C3D source config (configs/sim/mocap_c3d.yaml): the lab capture's marker clusters as rigid
+// bodies, the pelvis in the lab frame in metres (the sample's markers are in mm), flagged for calibration first.
+TEST(MocapConfig, TheShippedC3dConfigStreamsTheMarkerClustersAsBodies) {
+  // the shipped file, played once and as fast as it reads (not paced, no loop)
+  const std::string path = core::findData("configs/sim/mocap_c3d.yaml");
+  std::ifstream in(path);
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::size_t at = text.find("  loop: true\n");
+  ASSERT_NE(at, std::string::npos);
+  text.replace(at, 13, "  loop: false\n  paced: false\n");
+  auto src = makeSource(core::ConfigNode::parse(text, path));
+  ASSERT_EQ(src->kind(), "c3d");
+  const auto f = src->next(std::chrono::milliseconds(0));
+  ASSERT_TRUE(f.has_value());
+  EXPECT_TRUE(f->calibration_pose);
+  std::map<std::string, const mocap::Body*> bodies;
+  for (const mocap::Body& b : f->bodies) bodies[b.name] = &b;
+  for (const char* name : {"pelvis", "thigh_r", "shank_r", "foot_r", "thigh_l", "shank_l", "foot_l"}) EXPECT_EQ(bodies.count(name), 1u) << name;
+  ASSERT_EQ(bodies.count("pelvis"), 1u);
+  // a walking adult's pelvis markers are about a metre above the lab floor, whenever the pelvis is tracked
+  int frames = 0, tracked = 0;
+  for (auto g = f; g && frames < 450; g = src->next(std::chrono::milliseconds(0)), ++frames)
+    for (const mocap::Body& b : g->bodies)
+      if (b.name == "pelvis" && b.tracked) {
+        ++tracked;
+        EXPECT_GT(b.pose.p.z(), 0.7) << "frame " << frames;
+        EXPECT_LT(b.pose.p.z(), 1.3) << "frame " << frames;
+      }
+  std::printf("c3d source: pelvis tracked in %d of %d frames\n", tracked, frames);
+  EXPECT_EQ(frames, 450);
+  EXPECT_GT(tracked, frames / 2);
+}
+
 TEST(MocapConfig, BuildsSourcesAndNamesFileLineAndField) {
   auto bvh = makeSource(configOf(
       "source: bvh\nbvh:\n  file: data/bvh/cmu_max_131_03.bvh\n  map: configs/mappings/cmu.yaml\n  bodies: [pelvis, head]\n"));
@@ -259,5 +294,11 @@ TEST(MocapConfig, BuildsSourcesAndNamesFileLineAndField) {
   expectError("source: synthetic\nsynthetic:\n  rate_hz: abc\n  bodies: []\n", "field 'synthetic.rate_hz': 'abc' is not a number");
   expectError("source: synthetic\nsynthetic:\n  bodies:\n    - {name: a, center: [0, 0]}\n", "expected [x, y, z]");
   expectError("source: dtrack2\ndtrack2:\n  port: 99999\n  bodies: {0: head}\n", "field 'dtrack2.port'");
+  expectError("source: c3d\nc3d:\n  file: data/c3d/sample01_Eb015pr.c3d\n  mapping: configs/mappings/nothing.yaml\n",
+              "test.yaml:4: field 'c3d.mapping': configs/mappings/nothing.yaml: not found");
+  expectError("source: c3d\nc3d:\n  file: data/c3d/sample01_Eb015pr.c3d\n  mapping: configs/mappings/c3d_sample01.yaml\n  loops: true\n",
+              "test.yaml:5: field 'c3d.loops': unknown key");
+  expectError("source: c3d\nc3d:\n  file: data/c3d/sample01_Eb015pr.c3d\n  mapping: configs/mappings/c3d_sample01.yaml\n  end_frame: 9999\n",
+              "test.yaml:3: field 'c3d': ");
   EXPECT_THROW(core::ConfigNode::parse("a: [1, 2\n", "bad.yaml"), core::ConfigError);
 }

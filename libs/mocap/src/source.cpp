@@ -6,6 +6,7 @@
 #include "mannequin/core/paths.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/mocap/bvh_source.hpp"
+#include "mannequin/mocap/c3d_source.hpp"
 #include "mannequin/mocap/dtrack2.hpp"
 #include "mannequin/mocap/synthetic_source.hpp"
 #include "mannequin/skeleton/bvh_drive.hpp"
@@ -72,6 +73,37 @@ std::unique_ptr<Source> makeBvh(const ConfigNode& c) {
   o.mark_calibration = c.get("mark_calibration", true);
   try {
     return std::make_unique<BvhSource>(o);
+  } catch (const std::exception& e) {
+    c.fail(e.what());
+  }
+}
+
+std::unique_ptr<Source> makeC3d(const ConfigNode& c) {
+  c.allowOnly({"file", "mapping", "rate", "loop", "start_frame", "end_frame", "paced", "mark_calibration", "max_marker_error_m"});
+  C3dSourceOptions o;
+  try {
+    o.file = core::findData(c["file"].str());
+  } catch (const core::ConfigError& e) {
+    c["file"].fail(e.what());
+  }
+  std::string mapping;
+  try {
+    mapping = core::findData(c["mapping"].str());
+  } catch (const core::ConfigError& e) {
+    c["mapping"].fail(e.what());
+  }
+  o.mapping = loadC3dMapping(mapping);  // its own FILE:LINE errors
+  o.rate = c.getIn("rate", 1.0, 1e-3, 1e3);
+  o.loop = c.get("loop", false);
+  o.start_frame = c.get("start_frame", 0LL);
+  o.end_frame = c.get("end_frame", -1LL);
+  o.paced = c.get("paced", true);
+  o.mark_calibration = c.get("mark_calibration", true);
+  o.max_marker_error_m = c.getIn("max_marker_error_m", o.max_marker_error_m, 1e-4, 1.0);
+  try {
+    return std::make_unique<C3dSource>(std::move(o));
+  } catch (const core::ConfigError&) {
+    throw;  // the mapping's FILE:LINE
   } catch (const std::exception& e) {
     c.fail(e.what());
   }
@@ -154,7 +186,8 @@ std::unique_ptr<Source> makeSource(const ConfigNode& config) {
   if (k == "bvh") return makeBvh(config["bvh"]);
   if (k == "synthetic") return makeSynthetic(config["synthetic"]);
   if (k == "dtrack2") return makeDTrack(config["dtrack2"]);
-  kind.fail("unknown source '" + k + "' (expected bvh, synthetic or dtrack2)");
+  if (k == "c3d") return makeC3d(config["c3d"]);
+  kind.fail("unknown source '" + k + "' (expected bvh, c3d, synthetic or dtrack2)");
 }
 
 }  // namespace mannequin::mocap
