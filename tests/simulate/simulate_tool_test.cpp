@@ -16,6 +16,7 @@
 #include <regex>
 #include <sstream>
 #include <string>
+#include <utility>
 
 #include "mannequin/recording/mcap_reader.hpp"
 
@@ -66,6 +67,18 @@ std::optional<double> number(const std::string& json, const std::string& key) {
   std::smatch m;
   if (!std::regex_search(json, m, re)) return std::nullopt;
   return std::stod(m[1].str());
+}
+
+// Runs python3 on `json` with `script` (d = json.loads of it); its stdout and exit status.
+std::pair<int, std::string> pythonOn(const std::string& json, const std::string& script) {
+  const fs::path in = temp("out.json"), py = temp("check.py"), out = temp("check.txt");
+  std::ofstream(in) << json;
+  std::ofstream(py) << "import json, sys\nd = json.loads(open(sys.argv[1]).read())\n" << script << "\n";
+  const int st = std::system(("python3 " + py.string() + " " + in.string() + " >" + out.string() + " 2>&1").c_str());
+  std::ifstream o(out);
+  std::stringstream text;
+  text << o.rdbuf();
+  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, text.str()};
 }
 
 // The JSON without the wall-clock keys (the rest must be bit-identical between runs).
@@ -145,11 +158,23 @@ TEST(SimulateTool, BadMannequinMocapAndCaptureFilesNameFileAndLineAndExitTwo) {
 TEST(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {
   const ToolRun a = run("--config configs/sim/sim_demo.yaml --duration 1 --json");
   ASSERT_EQ(a.status, 0) << a.err;
-  // exactly one JSON object on stdout
+  // exactly one JSON object on stdout, on one line (python's json module reads it as a dict)
   ASSERT_FALSE(a.out.empty());
   EXPECT_EQ(a.out.front(), '{') << a.out;
-  EXPECT_EQ(a.out.find('{', 1), std::string::npos) << a.out;
-  EXPECT_EQ(a.out.substr(a.out.find('}')), "}\n") << a.out;
+  EXPECT_EQ(a.out.find('\n'), a.out.size() - 1) << a.out;
+  const auto [py_status, py_out] = pythonOn(a.out, "assert isinstance(d, dict)\nprint('ok')");
+  EXPECT_EQ(py_status, 0) << py_out;
+  EXPECT_EQ(py_out, "ok\n");
+  // the postures' ergonomic scores (libs/ergonomics) over the calibrated time: one entry per mannequin,
+  // RULA 1..7 and REBA 1..15 at most, the time at the action levels summing to the sampled time
+  const auto [e_status, e_out] = pythonOn(
+      a.out,
+      "e = d['ergonomics']\nassert len(e) == 1 and e[0]['mannequin'] == 'operator'\n"
+      "assert 1 <= e[0]['rula_max'] <= 7 and 1 <= e[0]['reba_max'] <= 15\n"
+      "assert len(e[0]['rula_time_at_action_level_s']) == 4 and len(e[0]['reba_time_at_action_level_s']) == 5\n"
+      "t = sum(e[0]['rula_time_at_action_level_s'])\nassert abs(t - sum(e[0]['reba_time_at_action_level_s'])) < 1e-9\n"
+      "assert abs(t - e[0]['samples'] / 60.0) < 1e-9 and 0.9 <= t <= 1.0 + 1e-9, t\nprint('ok')");
+  EXPECT_EQ(e_status, 0) << e_out << a.out;
   for (const char* k : kKeys) {  // min_balance_distance_m included: the feet's floor contacts give a support
     const auto v = number(a.out, k);
     ASSERT_TRUE(v.has_value()) << k << " missing or not a number in " << a.out;

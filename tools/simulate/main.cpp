@@ -3,10 +3,13 @@
 // replay mode), a summary of the run (human or --json), optionally the sim.world messages in an MCAP file
 // (the v1 messages mannequin-record writes; mannequin-replay reads it). See docs/cluster.md.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 #include <yaml-cpp/yaml.h>
 
+#include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -19,6 +22,8 @@
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/core/main.hpp"
 #include "mannequin/core/paths.hpp"
+#include "mannequin/core/text.hpp"
+#include "mannequin/ergonomics/ergonomics.hpp"
 #include "mannequin/mocap/bvh_source.hpp"
 #include "mannequin/mocap/source.hpp"
 #include "mannequin/proto/schema.hpp"
@@ -33,6 +38,18 @@ using namespace mannequin;
 namespace {
 
 constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+
+/// Per mannequin, the postures' ergonomic scores over the run (RULA and REBA of the worse side, sampled
+/// at the world rate once calibrated; libs/ergonomics with its default task input: no load, not static,
+/// not repeated — what a capture cannot say).
+struct ErgonomicsSummary {
+  std::string mannequin;
+  int rula_max = 0, reba_max = 0;
+  std::array<double, 4> rula_time_s{};  ///< at RULA action level 1..4
+  std::array<double, 5> reba_time_s{};  ///< at REBA action level 0..4
+  long long samples = 0;
+  long long failures = 0;  ///< postures the evaluator refused (non-finite q)
+};
 
 /// What a run measured (the --json keys).
 struct Summary {
@@ -50,6 +67,7 @@ struct Summary {
   double hand_error_sum = 0, foot_error_sum = 0;
   long long hand_samples = 0, foot_samples = 0;
   bool physics = false;
+  std::vector<ErgonomicsSummary> ergonomics;
 
   double meanContacts() const { return steps > 0 ? contact_sum / static_cast<double>(steps) : 0.0; }
   double footContactFraction() const {
@@ -108,19 +126,50 @@ void accumulate(const sim::World& world, bool ok, Summary& s) {
 /// A JSON number (null when not finite). %.17g: the same double prints the same text.
 std::string num(double v) { return std::isfinite(v) ? fmt::format("{:.17g}", v) : "null"; }
 
+/// One sample of every calibrated mannequin's posture, weighing `dt` seconds.
+void sampleErgonomics(const sim::World& world, std::vector<ergonomics::Evaluator>& evaluators, double dt, Summary& s) {
+  for (int m = 0; m < world.numMannequins(); ++m) {
+    if (!world.calibrated(m)) continue;
+    ErgonomicsSummary& e = s.ergonomics[static_cast<std::size_t>(m)];
+    try {
+      const ergonomics::Assessment a = evaluators[static_cast<std::size_t>(m)].evaluate(world.q(m));
+      const int rula = std::max(a.rula[0].grand, a.rula[1].grand), reba = std::max(a.reba[0].score, a.reba[1].score);
+      e.rula_max = std::max(e.rula_max, rula);
+      e.reba_max = std::max(e.reba_max, reba);
+      e.rula_time_s[static_cast<std::size_t>(ergonomics::rulaActionLevel(rula) - 1)] += dt;
+      e.reba_time_s[static_cast<std::size_t>(ergonomics::rebaActionLevel(reba))] += dt;
+      ++e.samples;
+    } catch (const std::invalid_argument&) {
+      ++e.failures;
+    }
+  }
+}
+
+std::string ergonomicsJson(const Summary& s) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < s.ergonomics.size(); ++i) {
+    const ErgonomicsSummary& e = s.ergonomics[i];
+    out += fmt::format("{}{{\"mannequin\": {}, \"samples\": {}, \"rula_max\": {}, \"rula_time_at_action_level_s\": [{}], "
+                       "\"reba_max\": {}, \"reba_time_at_action_level_s\": [{}]}}",
+                       i ? ", " : "", core::jsonString(e.mannequin), e.samples, e.rula_max, fmt::join(e.rula_time_s, ", "),
+                       e.reba_max, fmt::join(e.reba_time_s, ", "));
+  }
+  return out + "]";
+}
+
 void printJson(const Summary& s) {
   std::printf(
       "{\"frames\": %lld, \"steps\": %lld, \"sim_time_s\": %s, \"wall_s\": %s, \"realtime_factor\": %s, "
       "\"physics\": %s, \"nan_steps\": %lld, \"lcp_failures\": %lld, \"max_penetration_m\": %s, \"max_contacts\": %d, "
       "\"mean_contacts\": %s, \"foot_contact_fraction\": %s, \"min_balance_distance_m\": %s, "
       "\"worst_joint_limit_excess_rad\": %s, \"min_force_margin_n\": %s, \"mean_force_margin_n\": %s, "
-      "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld}\n",
+      "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld, \"ergonomics\": %s}\n",
       s.frames, s.steps, num(s.sim_time_s).c_str(), num(s.wall_s).c_str(), num(s.realtimeFactor()).c_str(),
       s.physics ? "true" : "false", s.nan_steps, s.lcp_failures, num(s.max_penetration_m).c_str(), s.max_contacts,
       num(s.meanContacts()).c_str(), num(s.footContactFraction()).c_str(), num(s.min_balance_distance_m).c_str(),
       num(s.worst_joint_limit_excess_rad).c_str(), num(s.min_force_margin_n).c_str(), num(s.meanForceMargin()).c_str(),
       num(s.meanHandError()).c_str(), num(s.meanFootError()).c_str(),
-      s.worlds);
+      s.worlds, ergonomicsJson(s).c_str());
 }
 
 void printHuman(const Summary& s, const std::string& out) {
@@ -146,6 +195,13 @@ void printHuman(const Summary& s, const std::string& out) {
   }
   std::printf("tracking    mean position error: hands %.1f mm, feet %.1f mm\n", s.meanHandError() * 1e3,
               s.meanFootError() * 1e3);
+  for (const ErgonomicsSummary& e : s.ergonomics) {
+    if (e.samples == 0) continue;
+    std::printf("ergonomics  %s: RULA max %d, time at action levels 1-4: %.1f / %.1f / %.1f / %.1f s; REBA max %d, "
+                "levels 0-4: %.1f / %.1f / %.1f / %.1f / %.1f s\n",
+                e.mannequin.c_str(), e.rula_max, e.rula_time_s[0], e.rula_time_s[1], e.rula_time_s[2], e.rula_time_s[3],
+                e.reba_max, e.reba_time_s[0], e.reba_time_s[1], e.reba_time_s[2], e.reba_time_s[3], e.reba_time_s[4]);
+  }
   if (!out.empty()) std::printf("wrote       %lld sim.world messages to %s\n", s.worlds, out.c_str());
 }
 
@@ -253,6 +309,16 @@ int main(int argc, char** argv) {
     sim::World& world = *setup.world;
     Summary s;
     s.physics = world.physics();
+    std::vector<ergonomics::Evaluator> evaluators;
+    for (int m = 0; m < world.numMannequins(); ++m) {
+      s.ergonomics.push_back({world.name(m)});
+      try {
+        evaluators.emplace_back(world.model(m));
+      } catch (const std::invalid_argument& e) {  // a model without the mannequin's joints (not buildMannequin's)
+        std::fprintf(stderr, "mannequin-simulate: %s: no ergonomic scores: %s\n", world.name(m).c_str(), e.what());
+        return core::kExitUsage;
+      }
+    }
 
     std::unique_ptr<recording::McapWriter> writer;
     std::uint16_t channel = 0;
@@ -269,6 +335,7 @@ int main(int argc, char** argv) {
       world_phase += config.world_rate * config.world.step;
       if (world_phase < 1.0 - 1e-9) return;
       world_phase -= 1.0;
+      sampleErgonomics(world, evaluators, 1.0 / config.world_rate, s);
       if (!writer) return;
       simservice::toWorldState(world, nullptr, false, true, msg);
       v1::Header* h = msg.mutable_header();
