@@ -45,7 +45,8 @@ class C3dTool : public ::testing::Test {
   ToolRun run(const std::string& args) {
     const fs::path out = dir_ / "out";
     const fs::path err = dir_ / "err";
-    const std::string cmd = toolPath().string() + " " + args + " >" + out.string() + " 2>" + err.string();
+    // a deadline: a hung tool fails the test (status 124 from timeout) instead of hanging ctest
+    const std::string cmd = "timeout 60 " + toolPath().string() + " " + args + " >" + out.string() + " 2>" + err.string();
     const int raw = std::system(cmd.c_str());
     ToolRun r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
@@ -61,7 +62,7 @@ class C3dTool : public ::testing::Test {
     const fs::path out = dir_ / "py.out";
     std::ofstream(in, std::ios::binary) << json;
     std::ofstream(py) << "import json, sys\nd = json.load(sys.stdin)\n" << script << "\n";
-    const std::string cmd = "python3 " + py.string() + " <" + in.string() + " >" + out.string() + " 2>&1";
+    const std::string cmd = "timeout 60 python3 " + py.string() + " <" + in.string() + " >" + out.string() + " 2>&1";
     const int raw = std::system(cmd.c_str());
     EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << slurp(out) << "\non:\n" << json;
     return slurp(out);

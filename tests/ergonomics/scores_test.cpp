@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <string>
 
@@ -629,4 +630,17 @@ TEST(BadInput, ClearErrors) {
   tiny.name = "tiny";
   tiny.addJoint("root", sk::JointType::kFreeFlyer, -1, sk::SE3::Identity());
   EXPECT_NE(message([&] { Evaluator e(tiny); }).find("has no joint 'thoracic'"), std::string::npos);
+  // angles a caller built: a NaN angle, a bad neutral band or side are errors, not the worst band
+  PostureAngles angles = f.eval.measure(q);
+  angles.body.trunk_flexion_deg = std::nan("");
+  EXPECT_NE(message([&] { scoreRula(angles, Side::kLeft, {}); }).find("trunk_flexion_deg is not finite"), std::string::npos);
+  angles = f.eval.measure(q);
+  angles.arm[1].wrist_flexion_deg = std::numeric_limits<double>::infinity();
+  EXPECT_NE(message([&] { scoreReba(angles, Side::kRight, {}); }).find("wrist_flexion_deg is not finite"), std::string::npos);
+  EXPECT_NO_THROW(scoreReba(angles, Side::kLeft, {}));  // the left arm's angles are fine
+  angles = f.eval.measure(q);
+  angles.neutral_deg = std::nan("");
+  EXPECT_NE(message([&] { scoreRula(angles, Side::kLeft, {}); }).find("neutral_deg"), std::string::npos);
+  angles = f.eval.measure(q);
+  EXPECT_NE(message([&] { scoreRula(angles, static_cast<Side>(7), {}); }).find("side must be left or right"), std::string::npos);
 }

@@ -2,6 +2,8 @@
 // actions, the context stack (interrupt / resume), observation checks, no allocation per step.
 #include <gtest/gtest.h>
 
+#include <cmath>
+
 #include <string>
 
 #include "../common/alloc_counter.hpp"
@@ -355,6 +357,12 @@ TEST(ScenarioEngine, RefusesMismatchedObservations) {
   t.step();
   t.obs.time -= 0.02;  // step() adds 0.01: 10 ms back in time
   EXPECT_THROW(t.step(), std::invalid_argument);
+  // a NaN time, even on the first step, is refused (it would poison every later time comparison)
+  Machine n("{time: 1}");
+  n.obs.time = std::nan("");
+  EXPECT_THROW(n.step(), std::invalid_argument);
+  n.obs.time = 0;
+  EXPECT_NO_THROW(n.step());
 }
 
 TEST(ScenarioEngine, Deterministic) {

@@ -74,7 +74,7 @@ std::pair<int, std::string> pythonOn(const std::string& json, const std::string&
   const fs::path in = temp("out.json"), py = temp("check.py"), out = temp("check.txt");
   std::ofstream(in) << json;
   std::ofstream(py) << "import json, sys\nd = json.loads(open(sys.argv[1]).read())\n" << script << "\n";
-  const int st = std::system(("python3 " + py.string() + " " + in.string() + " >" + out.string() + " 2>&1").c_str());
+  const int st = std::system(("timeout 60 python3 " + py.string() + " " + in.string() + " >" + out.string() + " 2>&1").c_str());
   std::ifstream o(out);
   std::stringstream text;
   text << o.rdbuf();

@@ -96,7 +96,15 @@ const StaticBalanceResult& StaticBalanceSolver::solve(const StaticBalanceProblem
   // the bias removal (3.92)
   X_ = qp_.X();
   X_.head(nf) -= eq.nu_prime_f - eq.nu_f;
-  result_.edge_forces = X_.head(nf).cwiseMax(0.0);  // rounding: −1e-15 is 0
+  // the answer's own check: edge forces ≥ 0 and G X = W, to a tolerance relative to the weight
+  const double tol = 1e-6 * (1.0 + eq.W.cwiseAbs().maxCoeff());
+  result_.min_raw_edge_force = X_.head(nf).minCoeff();
+  if (result_.min_raw_edge_force < -tol) {
+    result_.status = BalanceStatus::kLcpFailure;
+    result_.message = "static balance: the LCP's answer has a negative edge force (" + detail::num(result_.min_raw_edge_force) + " N)";
+    return result_;
+  }
+  result_.edge_forces = X_.head(nf).cwiseMax(0.0);  // rounding: −1e-12 is 0
   result_.margin_reserve = eq.nu_f - eq.nu_prime_f;
   result_.com = p.fix_com ? p.desired_com : math::Vector3(X_.tail<3>());
   result_.forces.resize(static_cast<std::size_t>(mc));
@@ -104,6 +112,11 @@ const StaticBalanceResult& StaticBalanceSolver::solve(const StaticBalanceProblem
   Eigen::VectorXd Xf(n);
   Xf << result_.edge_forces, result_.com;
   result_.equilibrium_residual = (eq.G * Xf - eq.W).cwiseAbs().maxCoeff();
+  if (!(result_.equilibrium_residual <= tol)) {
+    result_.status = BalanceStatus::kLcpFailure;
+    result_.message = "static balance: the answer misses the equilibrium by " + detail::num(result_.equilibrium_residual);
+    return result_;
+  }
   result_.status = BalanceStatus::kSolved;
   result_.message = "solved";
   return result_;

@@ -176,13 +176,26 @@ const VariationalBalanceResult& VariationalBalanceSolver::solve(const Variationa
   }
   const Eigen::VectorXd& X = qp_.X();
   r.dq = X.tail(nv);
-  r.edge_forces = (X.head(nf) - (eq.nu_prime_f - eq.nu_f)).cwiseMax(0.0);  // bias removal (3.92)
+  // bias removal (3.92), and the answer's own check: edge forces ≥ 0 and the (linearised) equilibrium
+  const double tol = 1e-6 * (1.0 + eq.W.cwiseAbs().maxCoeff());
+  r.min_raw_edge_force = (X.head(nf) - (eq.nu_prime_f - eq.nu_f)).minCoeff();
+  if (r.min_raw_edge_force < -tol) {
+    r.status = BalanceStatus::kLcpFailure;
+    r.message = "variational balance: the LCP's answer has a negative edge force (" + detail::num(r.min_raw_edge_force) + " N)";
+    return r;
+  }
+  r.edge_forces = (X.head(nf) - (eq.nu_prime_f - eq.nu_f)).cwiseMax(0.0);
   r.forces.resize(static_cast<std::size_t>(mc));
   for (int i = 0; i < mc; ++i) r.forces[static_cast<std::size_t>(i)] = eq.edges.middleCols(i * ma, ma) * r.edge_forces.segment(i * ma, ma);
   r.com = com + I.data.Jcom * r.dq;
   I.Xf.resize(nf + 3);
   I.Xf << r.edge_forces, r.com;
   r.equilibrium_residual = (eq.G * I.Xf - eq.W).cwiseAbs().maxCoeff();
+  if (!(r.equilibrium_residual <= tol)) {
+    r.status = BalanceStatus::kLcpFailure;
+    r.message = "variational balance: the answer misses the linearised equilibrium by " + detail::num(r.equilibrium_residual);
+    return r;
+  }
   r.status = BalanceStatus::kSolved;
   r.message = "solved";
   return r;

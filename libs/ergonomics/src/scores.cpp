@@ -127,8 +127,42 @@ void checkThresholds(const Thresholds& t) {
   if (!std::isfinite(t.out_to_side_m) || t.out_to_side_m < 0) bad("out_to_side_m", t.out_to_side_m);
 }
 
+namespace {
+/// The angles a caller built (scoreRula/scoreReba are public): finite, a valid side, a sane neutral band.
+/// \throws std::invalid_argument naming the field.
+void checkAngles(const PostureAngles& p, Side side) {
+  if (side != Side::kLeft && side != Side::kRight) throw std::invalid_argument("ergonomics: side must be left or right");
+  if (!std::isfinite(p.neutral_deg) || p.neutral_deg < 0 || p.neutral_deg > 45)
+    throw std::invalid_argument("ergonomics: neutral_deg must be in [0, 45] (got " + std::to_string(p.neutral_deg) + ")");
+  const auto check = [](double v, const char* what) {
+    if (!std::isfinite(v)) throw std::invalid_argument(std::string("ergonomics: angle ") + what + " is not finite");
+  };
+  const BodyAngles& b = p.body;
+  check(b.trunk_flexion_deg, "trunk_flexion_deg");
+  check(b.trunk_side_bend_deg, "trunk_side_bend_deg");
+  check(b.trunk_twist_deg, "trunk_twist_deg");
+  check(b.neck_flexion_deg, "neck_flexion_deg");
+  check(b.neck_side_bend_deg, "neck_side_bend_deg");
+  check(b.neck_twist_deg, "neck_twist_deg");
+  check(b.knee_flexion_deg[0], "knee_flexion_deg[0]");
+  check(b.knee_flexion_deg[1], "knee_flexion_deg[1]");
+  const ArmAngles& a = p.arm[static_cast<int>(side)];
+  check(a.upper_arm_flexion_deg, "upper_arm_flexion_deg");
+  check(a.upper_arm_abduction_deg, "upper_arm_abduction_deg");
+  check(a.shoulder_elevation_deg, "shoulder_elevation_deg");
+  check(a.elbow_flexion_deg, "elbow_flexion_deg");
+  check(a.wrist_flexion_deg, "wrist_flexion_deg");
+  check(a.wrist_deviation_deg, "wrist_deviation_deg");
+  check(a.forearm_rotation_deg, "forearm_rotation_deg");
+  check(a.forearm_rotation_fraction, "forearm_rotation_fraction");
+  check(a.wrist_lateral_m, "wrist_lateral_m");
+  check(a.shoulder_lateral_m, "shoulder_lateral_m");
+}
+}  // namespace
+
 RulaSide scoreRula(const PostureAngles& angles, Side side, const TaskInput& in) {
   checkTaskInput(in);
+  checkAngles(angles, side);
   const ArmAngles& a = angles.arm[static_cast<int>(side)];
   const BodyAngles& b = angles.body;
   const double neutral = angles.neutral_deg;
@@ -160,6 +194,7 @@ RulaSide scoreRula(const PostureAngles& angles, Side side, const TaskInput& in) 
 
 RebaSide scoreReba(const PostureAngles& angles, Side side, const TaskInput& in) {
   checkTaskInput(in);
+  checkAngles(angles, side);
   const ArmAngles& a = angles.arm[static_cast<int>(side)];
   const BodyAngles& b = angles.body;
   const double neutral = angles.neutral_deg;

@@ -90,8 +90,12 @@ class Reader {
   C3dProcessor proc_ = C3dProcessor::kIntel;
 };
 
-/// 16-bit counts the spec stores as int16 but writers use up to 65535.
-int unsignedCount(double v) { return v < 0 ? static_cast<int>(v) + 65536 : static_cast<int>(v); }
+/// 16-bit counts the spec stores as int16 but writers use up to 65535. −1 for a value that is not a
+/// whole number in [−32768, 65535] (a float parameter holding NaN or 1e30: no conversion of it is defined).
+int unsignedCount(double v) {
+  if (!std::isfinite(v) || v < -32768.0 || v > 65535.0 || v != std::floor(v)) return -1;
+  return v < 0 ? static_cast<int>(v) + 65536 : static_cast<int>(v);
+}
 
 }  // namespace
 
@@ -296,6 +300,7 @@ C3d parseC3d(std::string_view bytes, const std::string& file) {
   };
   if (const auto used = scalar("USED")) {
     const int n = unsignedCount(used->first);
+    if (n < 0) r.fail(used->second, "POINT:USED is not a whole count (" + std::to_string(used->first) + ")");
     if (n != c.points) {
       r.fail(used->second, "POINT:USED = " + std::to_string(n) + " but the header (byte 2) declares " +
                                std::to_string(c.points) + " points");
@@ -303,7 +308,10 @@ C3d parseC3d(std::string_view bytes, const std::string& file) {
   }
   if (const auto s = scalar("SCALE")) scale = s->first;
   if (const auto s = scalar("RATE")) rate = s->first;
-  if (const auto s = scalar("DATA_START")) data_start = unsignedCount(s->first);
+  if (const auto s = scalar("DATA_START")) {
+    data_start = unsignedCount(s->first);
+    if (data_start < 0) r.fail(s->second, "POINT:DATA_START is not a whole block number (" + std::to_string(s->first) + ")");
+  }
   if (!std::isfinite(scale) || scale == 0.0) r.fail(12, "bad point scale " + std::to_string(scale) + " (header or POINT:SCALE)");
   if (!std::isfinite(rate) || rate < 0.0) r.fail(20, "bad frame rate " + std::to_string(rate) + " (header or POINT:RATE)");
   c.scale = scale;

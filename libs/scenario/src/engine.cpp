@@ -206,6 +206,8 @@ const StepResult& Engine::step(const Observation& obs) {
       throw std::invalid_argument("scenario '" + s_.name + "': object '" + s_.objects[i].name + "' has " +
                                   std::to_string(obs.objects[i].values.size()) + " values, expected " +
                                   std::to_string(s_.objects[i].values.size()));
+  if (!std::isfinite(obs.time))
+    throw std::invalid_argument("scenario '" + s_.name + "': the observation's time is not finite");
   if (started_ && !(obs.time >= prev_time_))
     throw std::invalid_argument("scenario '" + s_.name + "': time went back (" + std::to_string(obs.time) + " s after " +
                                 std::to_string(prev_time_) + " s)");

@@ -70,13 +70,17 @@ struct StaticBalanceProblem {
   bool fix_com = false;
   /// CoM-position margins Δx_i (m, world): balanced even with the CoM moved by each of them (3.82).
   std::vector<math::Vector3> com_margins;
-  /// Disturbing-wrench margins D_i (moment about the origin, force; world): balanced even with each one
-  /// added to the external wrenches (3.94).
+  /// Disturbing-wrench margins D_i (moment about the origin, force; world), (3.94–3.95) as the thesis
+  /// writes them: the facets move by the f-rows of G⁺ = Gᵀ(GGᵀ)⁻¹ of the whole G. With the CoM free that
+  /// pseudo-inverse shares a push's moment between the forces and a CoM shift (G⁺)_x D (the CoM columns
+  /// weigh m g per metre): the answer is balanced under D with its CoM moved by that much, not at its
+  /// own CoM. With `fix_com` the rows are those of G_f⁺: balanced under D at the given CoM (tipping
+  /// guarded; forceMargin uses that form).
   std::vector<math::Vector6> force_margins;
 };
 
 enum class BalanceStatus {
-  kSolved,      ///< X satisfies G X = W and f^dis ≥ 0 (to the checked tolerance) and is optimal
+  kSolved,      ///< X satisfies G X = W and f^dis ≥ 0 to 10⁻⁶·(1 + ‖W‖∞) (checked on the answer) and is optimal
   kInfeasible,  ///< no static equilibrium exists for these contacts (with these margins): Lemke's ray
   kDegenerate,  ///< G Q_A⁻¹ Gᵀ singular: the contacts and the CoM cannot produce every wrench component
   kInvalid,     ///< bad input (message names it)
@@ -94,6 +98,7 @@ struct StaticBalanceResult {
   /// this, what the worst margin may take away before the contact slides or lifts; zeros without margins.
   Eigen::VectorXd margin_reserve;
   double equilibrium_residual = 0.0;       ///< ‖G X − W‖∞ (N, N·m)
+  double min_raw_edge_force = 0.0;         ///< the smallest edge force before rounding −10⁻¹² to 0 (N)
   int lcp_size = 0;                        ///< m_c·m_a
   int pivots = 0;
 };

@@ -81,6 +81,7 @@ struct VariationalBalanceResult {
   std::vector<math::Vector3> forces;       ///< per contact, world
   math::Vector3 com = math::Vector3::Zero();    ///< x_com,k + J_com δq (the linearised CoM at q_{k+1})
   double equilibrium_residual = 0.0;       ///< ‖G_f f + G_x x_com − W‖∞ with the linearised CoM
+  double min_raw_edge_force = 0.0;         ///< the smallest edge force before rounding −10⁻¹² to 0 (N)
   int equality_rows = 0, lcp_size = 0, pivots = 0;
 };
 
