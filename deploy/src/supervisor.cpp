@@ -14,11 +14,14 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <optional>
 #include <thread>
 
-#include "mannequin/core/process.hpp"
+#include "mannequin/deploy/heartbeat_monitor.hpp"
+#include "mannequin/deploy/process_backend.hpp"
+#include "mannequin/deploy/restart_policy.hpp"
+#include "mannequin/deploy/status_printer.hpp"
 #include "mannequin/transport/clock.hpp"
-#include "mannequin/transport/subscriber.hpp"
 
 namespace mannequin::deploy {
 
@@ -36,26 +39,7 @@ const char* toString(ServiceState s) {
 }
 
 namespace {
-double secondsSince(std::int64_t t0) { return (transport::steadyNs() - t0) * 1e-9; }
-
-std::string describeExit(int status) {
-  if (WIFEXITED(status)) return fmt::format("exit {}", WEXITSTATUS(status));
-  if (WIFSIGNALED(status)) return fmt::format("signal {} ({})", WTERMSIG(status), strsignal(WTERMSIG(status)));
-  return "unknown";
-}
-
-// The process group of a service (it is its group leader, setpgid in start). The check that a pid ≤ 0
-// (a service not running) is never signalled is core::signalProcess's; kNoProcess (it exited since the
-// last reap) is fine, the next reap collects it.
-const char* signalServiceGroup(pid_t pid, int sig) {
-  switch (core::signalProcess(pid, sig, core::SignalTarget::kGroup)) {
-    case core::SignalResult::kSent:
-    case core::SignalResult::kNoProcess: return nullptr;
-    case core::SignalResult::kRefused: return "refused (not a running process)";
-    case core::SignalResult::kFailed: return std::strerror(errno);
-  }
-  return "?";
-}
+double secondsSince(std::int64_t t0) { return static_cast<double>(transport::steadyNs() - t0) * 1e-9; }
 }  // namespace
 
 struct Supervisor::Impl {
@@ -64,14 +48,15 @@ struct Supervisor::Impl {
     std::string partial;         // incomplete last line
     std::int64_t started_ns = 0;
     std::int64_t restart_at_ns = 0;
-    double backoff = 0;
     bool stopping = false;
+    std::optional<RestartTracker> restarts;
   };
   std::vector<Child> children;
   zmq::context_t context;
-  std::unique_ptr<transport::Subscriber> heartbeats;
-  bool status_shown = false;  // tty: a status line is on screen
+  std::unique_ptr<ProcessBackend> backend = std::make_unique<LocalProcessBackend>();
+  std::unique_ptr<HeartbeatMonitor> heartbeats;
   std::size_t name_width = 8;
+  std::vector<Ended> ended;
 };
 
 Supervisor::Supervisor(Deployment deployment, SupervisorOptions options)
@@ -83,6 +68,7 @@ Supervisor::Supervisor(Deployment deployment, SupervisorOptions options)
     impl_->name_width = std::max(impl_->name_width, s.name.size());
   }
   impl_->children.resize(deployment_.services.size());
+  for (std::size_t i = 0; i < deployment_.services.size(); ++i) impl_->children[i].restarts.emplace(deployment_.services[i].restart);
   snapshot_ = status_;
 }
 
@@ -120,113 +106,49 @@ std::string Supervisor::resolveExec(const std::string& exec) const {
   return exec;  // execv fails and the child reports it
 }
 
-namespace {
-void writeAll(std::FILE* out, const std::string& s) {
-  std::fwrite(s.data(), 1, s.size(), out);
-  std::fflush(out);
-}
-}  // namespace
-
 int Supervisor::run(const std::atomic<bool>& stop) {
+  StatusPrinter out(options_.out, options_.tty, impl_->name_width);
   std::error_code ec;
   std::filesystem::create_directories(deployment_.run_dir, ec);
   if (ec) {
-    writeAll(options_.out, fmt::format("launch: cannot create the run directory {}: {}\n", deployment_.run_dir, ec.message()));
+    out.launcher(fmt::format("cannot create the run directory {}: {}", deployment_.run_dir, ec.message()));
     return 1;
   }
   chmod(deployment_.run_dir.c_str(), 0700);
 
-  // heartbeats of every service
-  transport::SubscriberOptions so;
-  so.name = "launch";
-  impl_->heartbeats = std::make_unique<transport::Subscriber>(impl_->context, so);
-  for (const auto& s : deployment_.services) impl_->heartbeats->connect(s.publish);
-  impl_->heartbeats->subscribe(
-      transport::topics::kHeartbeat,
-      std::function<void(const v1::Heartbeat&)>([this](const v1::Heartbeat& hb) {
-        for (auto& st : status_)
-          if (st.name == hb.service() || st.name == hb.header().source()) {
-            st.has_heartbeat = true;
-            st.last_heartbeat_ns = transport::steadyNs();
-            st.heartbeat = hb;
-            ++st.heartbeats;
-          }
-      }));
-
-  auto clearStatus = [&] {
-    if (options_.tty && impl_->status_shown) {
-      writeAll(options_.out, "\r\033[K");
-      impl_->status_shown = false;
-    }
-  };
-  auto emitLine = [&](std::size_t i, const std::string& line) {
-    clearStatus();
-    writeAll(options_.out, fmt::format("{:<{}} | {}\n", status_[i].name, impl_->name_width, line));
-  };
-  auto launcherLine = [&](const std::string& line) {
-    clearStatus();
-    writeAll(options_.out, fmt::format("{:<{}} | {}\n", "launch", impl_->name_width, line));
-  };
+  std::vector<std::string> endpoints;
+  for (const auto& s : deployment_.services) endpoints.push_back(s.publish);
+  impl_->heartbeats = std::make_unique<HeartbeatMonitor>(impl_->context, endpoints);
+  ProcessBackend& backend = *impl_->backend;
 
   auto start = [&](std::size_t i) {
-    const auto argv_s = deployment_.commandLine(i);
-    const std::string exe = resolveExec(argv_s[0]);
-    int fds[2];
-    if (pipe2(fds, O_CLOEXEC) != 0) {
-      launcherLine(fmt::format("{}: pipe failed: {}", status_[i].name, std::strerror(errno)));
+    std::vector<std::string> argv = deployment_.commandLine(i);
+    std::string cmd;
+    for (const auto& a : argv) cmd += (cmd.empty() ? "" : " ") + a;
+    argv[0] = resolveExec(argv[0]);
+    std::string error;
+    const std::optional<Launched> launched = backend.start(argv, error);
+    if (!launched) {
+      out.launcher(fmt::format("{}: {}", status_[i].name, error));
       return;
     }
-    std::vector<char*> argv;
-    for (const auto& a : argv_s) argv.push_back(const_cast<char*>(a.c_str()));
-    argv.push_back(nullptr);
-    const pid_t parent = getpid();
-    const pid_t pid = fork();
-    if (pid == 0) {
-      setpgid(0, 0);
-      prctl(PR_SET_PDEATHSIG, SIGTERM);
-      if (getppid() != parent) _exit(126);  // the launcher died between fork and prctl
-      sigset_t none;
-      sigemptyset(&none);
-      sigprocmask(SIG_SETMASK, &none, nullptr);
-      signal(SIGINT, SIG_DFL);
-      signal(SIGTERM, SIG_DFL);
-      signal(SIGPIPE, SIG_DFL);
-      dup2(fds[1], STDOUT_FILENO);
-      dup2(fds[1], STDERR_FILENO);
-      int devnull = open("/dev/null", O_RDONLY);
-      if (devnull >= 0) dup2(devnull, STDIN_FILENO);
-      execv(exe.c_str(), argv.data());
-      const std::string msg = fmt::format("cannot execute '{}': {}\n", exe, std::strerror(errno));
-      (void)!write(STDERR_FILENO, msg.data(), msg.size());
-      _exit(127);
-    }
-    close(fds[1]);
-    if (pid < 0) {
-      close(fds[0]);
-      launcherLine(fmt::format("{}: fork failed: {}", status_[i].name, std::strerror(errno)));
-      return;
-    }
-    setpgid(pid, pid);
     auto& c = impl_->children[i];
     if (c.fd >= 0) close(c.fd);
-    c.fd = fds[0];
-    fcntl(c.fd, F_SETFL, O_NONBLOCK);
+    c.fd = launched->output_fd;
     c.partial.clear();
     c.started_ns = transport::steadyNs();
     c.stopping = false;
     auto& st = status_[i];
-    st.pid = pid;
-    st.pids.push_back(pid);
+    st.pid = launched->pid;
+    st.pids.push_back(launched->pid);
     ++st.starts;
     st.state = ServiceState::kStarting;
     st.has_heartbeat = false;
     st.last_exit.clear();
-    std::string cmd;
-    for (const auto& a : argv_s) cmd += (cmd.empty() ? "" : " ") + a;
-    launcherLine(fmt::format("started {} (pid {}): {}", st.name, pid, cmd));
+    out.launcher(fmt::format("started {} (pid {}): {}", st.name, launched->pid, cmd));
   };
 
-  auto drain = [&](std::size_t i, bool final) {
+  auto drain = [&](std::size_t i) {
     auto& c = impl_->children[i];
     if (c.fd < 0) return;
     char buf[8192];
@@ -236,63 +158,61 @@ int Supervisor::run(const std::atomic<bool>& stop) {
         c.partial.append(buf, static_cast<std::size_t>(n));
         std::size_t nl;
         while ((nl = c.partial.find('\n')) != std::string::npos) {
-          emitLine(i, c.partial.substr(0, nl));
+          out.line(status_[i].name, c.partial.substr(0, nl));
           c.partial.erase(0, nl + 1);
         }
         continue;
       }
       if (n == 0 || (n < 0 && errno != EAGAIN && errno != EINTR)) {  // EOF: the child closed its output
-        if (!c.partial.empty()) emitLine(i, c.partial);
+        if (!c.partial.empty()) out.line(status_[i].name, c.partial);
         c.partial.clear();
         close(c.fd);
         c.fd = -1;
       }
       break;
     }
-    (void)final;
   };
 
   auto reap = [&](bool shutting_down) {
-    int status = 0;
-    pid_t pid;
-    while ((pid = waitpid(-1, &status, WNOHANG)) > 0) {
+    impl_->ended.clear();
+    backend.reap(impl_->ended);
+    for (const Ended& e : impl_->ended) {
       for (std::size_t i = 0; i < status_.size(); ++i) {
         auto& st = status_[i];
-        if (st.pid != pid) continue;
-        drain(i, true);
+        if (st.pid != e.pid) continue;
+        drain(i);
         auto& c = impl_->children[i];
         st.pid = -1;
-        st.last_exit = describeExit(status);
-        const bool ok_exit = WIFEXITED(status) && WEXITSTATUS(status) == 0;
-        const bool term = WIFSIGNALED(status) && WTERMSIG(status) == SIGTERM && c.stopping;
+        st.last_exit = describeExit(e.status);
+        const bool ok_exit = WIFEXITED(e.status) && WEXITSTATUS(e.status) == 0;
+        const bool term = WIFSIGNALED(e.status) && WTERMSIG(e.status) == SIGTERM && c.stopping;
         if (shutting_down || c.stopping) {
           st.state = ServiceState::kStopped;
           if (!ok_exit && !term) st.clean_exit = false;
-          launcherLine(fmt::format("{} stopped ({})", st.name, st.last_exit));
+          out.launcher(fmt::format("{} stopped ({})", st.name, st.last_exit));
           continue;
         }
-        const RestartOptions& r = deployment_.services[i].restart;
-        const double ran = secondsSince(c.started_ns);
-        if (ran >= r.stable_after) {
-          st.restarts = 0;
-          c.backoff = 0;
-        }
-        const bool restart = r.policy == RestartPolicy::kAlways || (r.policy == RestartPolicy::kOnFailure && !ok_exit);
         if (!ok_exit) st.clean_exit = false;
-        if (!restart) {
-          st.state = ok_exit ? ServiceState::kFinished : ServiceState::kFailed;
-          launcherLine(fmt::format("{} {} ({}), not restarted", st.name, ok_exit ? "finished" : "failed", st.last_exit));
-          continue;
+        RestartTracker& r = *c.restarts;
+        switch (r.onExit(ok_exit, secondsSince(c.started_ns))) {
+          case RestartTracker::Decision::kFinished:
+          case RestartTracker::Decision::kFailed:
+            st.restarts = r.restarts();
+            st.state = ok_exit ? ServiceState::kFinished : ServiceState::kFailed;
+            out.launcher(fmt::format("{} {} ({}), not restarted", st.name, ok_exit ? "finished" : "failed", st.last_exit));
+            break;
+          case RestartTracker::Decision::kFailedPermanently:
+            st.restarts = r.restarts();
+            st.state = ServiceState::kFailed;
+            out.launcher(fmt::format("{} exited ({}) after {} restarts: failed permanently", st.name, st.last_exit, r.restarts()));
+            break;
+          case RestartTracker::Decision::kRestart:
+            st.restarts = r.restarts();
+            c.restart_at_ns = transport::steadyNs() + static_cast<std::int64_t>(r.backoff() * 1e9);
+            st.state = ServiceState::kBackoff;
+            out.launcher(fmt::format("{} exited ({}), restarting in {:.1f} s", st.name, st.last_exit, r.backoff()));
+            break;
         }
-        if (st.restarts >= r.max_restarts) {
-          st.state = ServiceState::kFailed;
-          launcherLine(fmt::format("{} exited ({}) after {} restarts: failed permanently", st.name, st.last_exit, st.restarts));
-          continue;
-        }
-        c.backoff = c.backoff == 0 ? r.backoff_initial : std::min(r.backoff_max, 2 * c.backoff);
-        c.restart_at_ns = transport::steadyNs() + static_cast<std::int64_t>(c.backoff * 1e9);
-        st.state = ServiceState::kBackoff;
-        launcherLine(fmt::format("{} exited ({}), restarting in {:.1f} s", st.name, st.last_exit, c.backoff));
       }
     }
   };
@@ -301,61 +221,55 @@ int Supervisor::run(const std::atomic<bool>& stop) {
   for (std::size_t i = 0; i < deployment_.services.size(); ++i) start(i);
   publishSnapshot();
   std::int64_t last_status = t0;
+  std::vector<pollfd> fds;
   while (!stop.load()) {
     if (options_.duration > 0 && secondsSince(t0) >= options_.duration) {
-      launcherLine(fmt::format("duration of {} s reached", options_.duration));
+      out.launcher(fmt::format("duration of {} s reached", options_.duration));
       break;
     }
     // wait for output (or 20 ms)
-    std::vector<pollfd> fds;
+    fds.clear();
     for (const auto& c : impl_->children)
       if (c.fd >= 0) fds.push_back({c.fd, POLLIN, 0});
     if (fds.empty())
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     else
       ::poll(fds.data(), fds.size(), 20);
-    for (std::size_t i = 0; i < status_.size(); ++i) drain(i, false);
+    for (std::size_t i = 0; i < status_.size(); ++i) drain(i);
     reap(false);
-    impl_->heartbeats->poll(std::chrono::microseconds(0));
+    impl_->heartbeats->poll(status_);
     const std::int64_t now = transport::steadyNs();
     for (std::size_t i = 0; i < status_.size(); ++i) {
       auto& st = status_[i];
       auto& c = impl_->children[i];
       if (st.state == ServiceState::kBackoff && now >= c.restart_at_ns) {
-        ++st.restarts;
+        c.restarts->restarted();
+        st.restarts = c.restarts->restarts();
         start(i);
       }
       if (st.pid > 0) {
-        if (st.has_heartbeat)
-          st.state = (now - st.last_heartbeat_ns) * 1e-9 > deployment_.heartbeat_timeout ? ServiceState::kLate : ServiceState::kUp;
-        else if (secondsSince(c.started_ns) > deployment_.heartbeat_timeout)
-          st.state = ServiceState::kLate;
+        const ServiceState live = liveness(st.has_heartbeat, st.last_heartbeat_ns, c.started_ns, now, deployment_.heartbeat_timeout);
+        if (live != ServiceState::kStarting) st.state = live;
       }
     }
     const double period = options_.tty ? 0.25 : options_.status_period;
-    if (period > 0 && (now - last_status) * 1e-9 >= period) {
+    if (period > 0 && static_cast<double>(now - last_status) * 1e-9 >= period) {
       last_status = now;
-      if (options_.tty) {
-        clearStatus();
-        writeAll(options_.out, statusLineOf(status_));
-        impl_->status_shown = true;
-      } else {
-        writeAll(options_.out, fmt::format("{:<{}} | {}\n", "status", impl_->name_width, statusLineOf(status_)));
-      }
+      out.status(statusLineOf(status_));
     }
     publishSnapshot();
   }
 
   // shutdown: SIGTERM in reverse order, then SIGKILL after the timeout; reap everything
-  clearStatus();
-  launcherLine("stopping every service");
+  out.clear();
+  out.launcher("stopping every service");
   for (std::size_t k = status_.size(); k-- > 0;) {
     auto& st = status_[k];
     if (st.state == ServiceState::kBackoff) st.state = ServiceState::kStopped;
     if (st.pid <= 0) continue;
     impl_->children[k].stopping = true;
-    if (const char* error = signalServiceGroup(st.pid, SIGTERM))
-      launcherLine(fmt::format("{} (pid {}): SIGTERM {}", st.name, st.pid, error));
+    if (const char* error = backend.signalGroup(st.pid, SIGTERM))
+      out.launcher(fmt::format("{} (pid {}): SIGTERM {}", st.name, st.pid, error));
   }
   publishSnapshot();
   const std::int64_t stop_start = transport::steadyNs();
@@ -366,15 +280,15 @@ int Supervisor::run(const std::atomic<bool>& stop) {
   };
   bool killed = false;
   while (anyRunning()) {
-    impl_->heartbeats->poll(std::chrono::microseconds(0));  // keep the last heartbeats (final statistics)
-    for (std::size_t i = 0; i < status_.size(); ++i) drain(i, false);
+    impl_->heartbeats->poll(status_);  // keep the last heartbeats (final statistics)
+    for (std::size_t i = 0; i < status_.size(); ++i) drain(i);
     reap(true);
     if (!killed && secondsSince(stop_start) > deployment_.stop_timeout) {
       for (auto& st : status_)
         if (st.pid > 0) {
-          launcherLine(fmt::format("{} did not stop within {} s: SIGKILL", st.name, deployment_.stop_timeout));
-          if (const char* error = signalServiceGroup(st.pid, SIGKILL))
-            launcherLine(fmt::format("{} (pid {}): SIGKILL {}", st.name, st.pid, error));
+          out.launcher(fmt::format("{} did not stop within {} s: SIGKILL", st.name, deployment_.stop_timeout));
+          if (const char* error = backend.signalGroup(st.pid, SIGKILL))
+            out.launcher(fmt::format("{} (pid {}): SIGKILL {}", st.name, st.pid, error));
           st.clean_exit = false;
         }
       killed = true;
@@ -382,8 +296,8 @@ int Supervisor::run(const std::atomic<bool>& stop) {
     publishSnapshot();
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   }
-  impl_->heartbeats->poll(std::chrono::microseconds(0));
-  for (std::size_t i = 0; i < status_.size(); ++i) drain(i, true);
+  impl_->heartbeats->poll(status_);
+  for (std::size_t i = 0; i < status_.size(); ++i) drain(i);
   std::filesystem::remove(deployment_.run_dir, ec);  // only if empty
   publishSnapshot();
 
