@@ -6,6 +6,7 @@
 #include "bench_main.hpp"
 #include "mannequin/ergonomics/ergonomics.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
+#include "mannequin/skeleton/kinematics.hpp"
 
 using namespace mannequin;
 
@@ -43,6 +44,21 @@ void BM_EvaluatePosture(benchmark::State& state) {
   }
 }
 
+// what the sim pays per frame: it has the kinematics of the step already
+void BM_EvaluateFromKinematics(benchmark::State& state) {
+  ergonomics::Evaluator e(model());
+  std::vector<skeleton::Data> data;
+  for (const skeleton::VectorX& q : postures()) {
+    data.emplace_back(model());
+    skeleton::forwardKinematics(model(), data.back(), q);
+  }
+  std::size_t i = 0;
+  for (auto _ : state) {
+    const ergonomics::Assessment a = e.evaluate(data[i++ % data.size()]);
+    benchmark::DoNotOptimize(a.rula[0].grand + a.reba[1].score);
+  }
+}
+
 void BM_ScoreFromAngles(benchmark::State& state) {
   ergonomics::Evaluator e(model());
   std::vector<ergonomics::PostureAngles> angles;
@@ -60,6 +76,7 @@ void BM_ScoreFromAngles(benchmark::State& state) {
 }  // namespace
 
 BENCHMARK(BM_EvaluatePosture)->Unit(benchmark::kMicrosecond);
+BENCHMARK(BM_EvaluateFromKinematics)->Unit(benchmark::kMicrosecond);
 BENCHMARK(BM_ScoreFromAngles)->Unit(benchmark::kMicrosecond);
 
 MANNEQUIN_BENCHMARK_MAIN("bench-ergonomics", "configs/mannequins/male_50th.yaml")

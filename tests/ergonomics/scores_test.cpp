@@ -599,6 +599,42 @@ TEST(Reach, DistanceFromTheShoulderAgainstTheArmLength) {
   EXPECT_LE(r.distance, r.arm_length);
 }
 
+// Scoring from the caller's kinematics (the sim's data after a step) gives what scoring from q gives,
+// angle for angle, and refuses a data of another model or a non-finite pose.
+TEST(Evaluator, FromTheCallersKinematicsAsFromQ) {
+  Fixture f;
+  const sk::VectorX q0 = f.standing();
+  sk::Data d(f.model);
+  for (int k = 0; k < 8; ++k) {
+    sk::VectorX q = q0;
+    for (int j = 6; j < f.model.nq; ++j) {
+      const double lo = f.model.lower_limit[j], hi = f.model.upper_limit[j];
+      if (std::isfinite(lo) && std::isfinite(hi)) q[j] = q0[j] + (k / 8.0) * 0.6 * (0.5 * (lo + hi) - q0[j]);
+    }
+    sk::forwardKinematics(f.model, d, q);
+    const Assessment a = f.eval.evaluate(q), b = f.eval.evaluate(d);
+    EXPECT_EQ(a.angles.body.trunk_flexion_deg, b.angles.body.trunk_flexion_deg) << k;
+    EXPECT_EQ(a.angles.arm[0].upper_arm_flexion_deg, b.angles.arm[0].upper_arm_flexion_deg) << k;
+    EXPECT_EQ(a.angles.arm[1].wrist_deviation_deg, b.angles.arm[1].wrist_deviation_deg) << k;
+    EXPECT_EQ(a.angles.body.neck_twist_deg, b.angles.body.neck_twist_deg) << k;
+    for (int s = 0; s < 2; ++s) {
+      EXPECT_EQ(a.rula[s].grand, b.rula[s].grand) << k;
+      EXPECT_EQ(a.reba[s].score, b.reba[s].score) << k;
+    }
+  }
+  sk::Data bad = d;
+  bad.oMi[3].p.x() = std::nan("");
+  try {
+    f.eval.evaluate(bad);
+    ADD_FAILURE() << "no error for a NaN joint pose";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("is not finite"), std::string::npos) << e.what();
+  }
+  bad = d;
+  bad.oMf.pop_back();
+  EXPECT_THROW(f.eval.evaluate(bad), std::invalid_argument);
+}
+
 TEST(BadInput, ClearErrors) {
   Fixture f;
   sk::VectorX q = f.standing();

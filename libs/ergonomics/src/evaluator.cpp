@@ -90,7 +90,36 @@ void Evaluator::checkQ(const VectorX& q) const {
 PostureAngles Evaluator::measure(const VectorX& q) {
   checkQ(q);
   skeleton::forwardKinematics(model_, data_, q);
-  const auto& oMi = data_.oMi;
+  return angles(data_);
+}
+
+PostureAngles Evaluator::measure(const skeleton::Data& data) {
+  if (data.oMi.size() != model_.joints.size() || data.oMf.size() != model_.frames.size())
+    throw std::invalid_argument("ergonomics: the kinematics data has " + std::to_string(data.oMi.size()) + " joints and " +
+                                std::to_string(data.oMf.size()) + " frames, the model '" + model_.name + "' " +
+                                std::to_string(model_.joints.size()) + " and " + std::to_string(model_.frames.size()));
+  for (std::size_t i = 0; i < data.oMi.size(); ++i)
+    if (!data.oMi[i].R.allFinite() || !data.oMi[i].p.allFinite())
+      throw std::invalid_argument("ergonomics: the pose of joint '" + model_.joints[i].name + "' is not finite");
+  for (std::size_t i = 0; i < data.oMf.size(); ++i)
+    if (!data.oMf[i].R.allFinite() || !data.oMf[i].p.allFinite())
+      throw std::invalid_argument("ergonomics: the pose of frame '" + model_.frames[i].name + "' is not finite");
+  return angles(data);
+}
+
+Assessment Evaluator::evaluate(const skeleton::Data& data, const TaskInput& input) {
+  checkTaskInput(input);
+  Assessment r;
+  r.angles = measure(data);
+  for (Side s : {Side::kLeft, Side::kRight}) {
+    r.rula[static_cast<int>(s)] = scoreRula(r.angles, s, input);
+    r.reba[static_cast<int>(s)] = scoreReba(r.angles, s, input);
+  }
+  return r;
+}
+
+PostureAngles Evaluator::angles(const skeleton::Data& data) const {
+  const auto& oMi = data.oMi;
   const Thresholds& t = thresholds_;
   PostureAngles out;
   out.neutral_deg = t.neutral_deg;
@@ -116,7 +145,7 @@ PostureAngles Evaluator::measure(const VectorX& q) {
 
   // neck: the head's long axis (neck joint → vertex) in the thorax frame
   const skeleton::Matrix3 Rn = Rt.transpose() * oMi[neck_].R;
-  const Vector3 h = Rt.transpose() * (data_.oMf[head_top_].p - oMi[neck_].p).normalized();
+  const Vector3 h = Rt.transpose() * (data.oMf[head_top_].p - oMi[neck_].p).normalized();
   b.neck_flexion_deg = std::atan2(h.x(), h.z()) * kRad2Deg;
   b.neck_side_bend_deg = std::asin(clamp1(h.y())) * kRad2Deg;
   b.neck_twist_deg = twistAbout(Rn, Vector3::UnitZ());

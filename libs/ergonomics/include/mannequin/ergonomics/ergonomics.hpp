@@ -190,6 +190,11 @@ class Evaluator {
   PostureAngles measure(const VectorX& q);
   /// Angles, RULA and REBA of both sides.
   Assessment evaluate(const VectorX& q, const TaskInput& input = {});
+  /// The same from kinematics the caller already has (skeleton::forwardKinematics of this model: oMi and
+  /// oMf), e.g. the sim's after a step: no forward kinematics again. \throws std::invalid_argument on a
+  /// data of another size or a non-finite pose (named).
+  PostureAngles measure(const skeleton::Data& data);
+  Assessment evaluate(const skeleton::Data& data, const TaskInput& input = {});
   JointLimitReport jointLimits(const VectorX& q) const;
   /// \throws std::invalid_argument on a non-finite target.
   ReachResult reach(const VectorX& q, Side side, const Vector3& target);
@@ -198,6 +203,7 @@ class Evaluator {
 
  private:
   void checkQ(const VectorX& q) const;
+  PostureAngles angles(const skeleton::Data& data) const;
   const skeleton::Model& model_;
   Thresholds thresholds_;
   skeleton::Data data_;
