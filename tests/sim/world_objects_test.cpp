@@ -16,6 +16,8 @@
 #include "mannequin/math/so3.hpp"
 #include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/sim/world.hpp"
+#include "mannequin/scenario/engine.hpp"
+#include "mannequin/scenario/scenario.hpp"
 #include "../constraints/male50_fixture.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
@@ -652,4 +654,62 @@ TEST(WorldPhysics, BalanceRowsKeepALeaningMannequinsCoMOverItsFeet) {
   EXPECT_LT(free_d, -0.02);   // the CoM leaves the support polygon
   EXPECT_GT(held_d, -0.005);  // kept over the feet (first-order prediction, recovery 0.1 m/s)
   EXPECT_GT(held_err, free_err);
+}
+
+// A scenario in the loop (World::setScenario, thesis 4.1.2): the right hand follows the capture (free)
+// until the operator's trigger, then goes autonomously to a goal 45 cm in front of the chest while the
+// actor stands still: the hand reaches the goal (the capture's hand stays 40 cm away from it), and the
+// switch is velocity-continuous — the hand's speed never jumps between two steps.
+TEST(WorldScenario, ATriggerSwitchesAFrameFromTheCaptureToAnAutonomousReach) {
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("operator", ""));
+  World w(std::move(setups), SimConfig{});
+  const math::Vector3 goal(0.45, -0.25, 1.2);
+  w.setScenario(scenario::parseScenario(
+      "scenario: reach\nmannequins:\n  - name: operator\n    frames: [hand_r]\ntriggers: [go]\ninitial: follow\n"
+      "states:\n  - name: follow\n    modes: {hand_r: free}\n    transitions:\n      - {to: reach, name: go, when: {trigger: go}}\n"
+      "  - name: reach\n    modes:\n      hand_r: {mode: autonomous, goal: {xyz: [0.45, -0.25, 1.2], rpy_deg: [0, 0, 0]}, duration_s: 1.0}\n",
+      "reach.yaml"));
+  ASSERT_NE(w.scenarioEngine(), nullptr);
+  const math::SE3 base = placed(0, 0, 0);
+  w.addMocap(actorFrame(0, base));
+  w.anchor(0);
+  ASSERT_TRUE(w.calibrated(0));
+  const auto feed = [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base)); };
+  ASSERT_TRUE(run(w, 0, 0.5, feed));
+  EXPECT_EQ(w.scenarioEngine()->stateName(), "follow");
+  const DrivenFrame& hand = w.controlFrames(0)[3];
+  ASSERT_EQ(hand.frame, "hand_r");
+  EXPECT_LT(hand.position_error, 0.02) << "free: the hand follows the capture";
+  const math::Vector3 captured = hand.target.p;
+  w.trigger("go");
+  // the target the controller is given (DrivenFrame::target, the scenario's setpoint): its velocity
+  // between steps, and how much that changes from one step to the next
+  math::Vector3 prev = hand.target.p, prev_v = math::Vector3::Zero();
+  double worst_dv = 0, top_speed = 0;
+  bool first = true;
+  ASSERT_TRUE(run(w, 0.5, 1.5, feed, [&](double) {
+    const math::Vector3 v = (hand.target.p - prev) / w.config().step;
+    if (!first) worst_dv = std::max(worst_dv, (v - prev_v).norm());
+    top_speed = std::max(top_speed, v.norm());
+    first = false;
+    prev = hand.target.p;
+    prev_v = v;
+    return true;
+  }));
+  EXPECT_EQ(w.scenarioEngine()->stateName(), "reach");
+  std::printf("scenario: hand %.4f m from the goal, the capture's hand %.3f m from it; target: top speed %.3f m/s, "
+              "worst speed change %.5f m/s per step\n", (hand.actual.p - goal).norm(), (captured - goal).norm(), top_speed, worst_dv);
+  EXPECT_GT((captured - goal).norm(), 0.3) << "the goal is not where the capture's hand is";
+  EXPECT_LT((hand.actual.p - goal).norm(), 0.02) << "the hand reached the autonomous goal";
+  // a minimum-jerk reach of d = 0.55 m in T = 1 s peaks at 1.875 d/T ≈ 1.03 m/s and accelerates at most
+  // 5.77 d/T² ≈ 3.2 m/s², 3.2 mm/s per 1 ms step; a target that jumped to the goal would move 0.55 m in one
+  // step (550 m/s)
+  EXPECT_LT(top_speed, 1.875 * 0.56 / 1.0 + 0.05) << "m/s";
+  EXPECT_LT(worst_dv, 5.77 * 0.56 / 1.0 * w.config().step * 1.5) << "m/s per step";
+  EXPECT_EQ(w.scenarioUnappliedActions(), 0);
+  // names the World lacks are refused
+  EXPECT_THROW(w.setScenario(scenario::parseScenario("scenario: x\nmannequins:\n  - name: bob\n    frames: [hand_r]\ninitial: a\n"
+                                                       "states:\n  - name: a\n    modes: {hand_r: free}\n", "x.yaml")),
+               std::invalid_argument);
 }

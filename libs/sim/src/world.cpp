@@ -1,6 +1,7 @@
 #include "mannequin/sim/world.hpp"
 
 #include "mannequin/balance/static_balance.hpp"
+#include "mannequin/scenario/engine.hpp"
 
 #include <algorithm>
 #include <chrono>
@@ -344,7 +345,113 @@ const MannequinDiagnostics& World::mannequinDiagnostics(int m) const {
   return mannequin_diagnostics_.at(static_cast<std::size_t>(m));
 }
 
+/// A scenario in the loop: its engine, where its frames and objects are in this World.
+struct World::ScenarioRun {
+  std::unique_ptr<scenario::Engine> engine;
+  struct Frame {
+    int mannequin = -1;
+    std::size_t driven = 0;  // index in the mannequin's DrivenFrames
+  };
+  std::vector<Frame> frames;       // per scenario frame
+  std::vector<int> objects;        // per scenario object: the World's object index
+  std::vector<int> grasp_handle;   // per scenario frame: its grasp (−1: none)
+  std::vector<scenario::Trigger> pending;
+  scenario::Observation obs;
+  long unapplied = 0;
+};
+
 World::~World() = default;
+
+void World::setScenario(scenario::Scenario sc) {
+  auto run = std::make_unique<ScenarioRun>();
+  const std::string where = "sim: scenario '" + sc.name + "'";
+  for (const scenario::FrameRef& f : sc.frames) {
+    int m = -1;
+    for (int k = 0; k < numMannequins(); ++k)
+      if (name(k) == f.mannequin) m = k;
+    if (m < 0) throw std::invalid_argument(where + ": no mannequin '" + f.mannequin + "' in the World");
+    const Mannequin& mm = *mannequins_[static_cast<std::size_t>(m)];
+    std::size_t driven = mm.frames.size();
+    for (std::size_t i = 0; i < mm.frames.size(); ++i)
+      if (mm.frames[i].frame == f.frame) driven = i;
+    if (driven == mm.frames.size())
+      throw std::invalid_argument(where + ": mannequin '" + f.mannequin + "' has no control frame '" + f.frame +
+                                  "' driven by mocap (the sim config's control_frames)");
+    run->frames.push_back({m, driven});
+  }
+  for (const scenario::ObjectDecl& o : sc.objects) {
+    const int k = physics_ ? findObject(o.name) : -1;
+    if (k < 0) throw std::invalid_argument(where + ": no object '" + o.name + "' in the World (movable scene bodies, physics on)");
+    for (const std::string& v : o.values)
+      if (v != "angle" || !object(k).hinged())
+        throw std::invalid_argument(where + ": object '" + o.name + "' value '" + v +
+                                    "': the World reports only 'angle', of hinged objects");
+    run->objects.push_back(k);
+  }
+  run->grasp_handle.assign(run->frames.size(), -1);
+  run->obs.frames.resize(run->frames.size());
+  run->obs.objects.resize(run->objects.size());
+  for (std::size_t k = 0; k < run->objects.size(); ++k) run->obs.objects[k].values.resize(sc.objects[k].values.size());
+  run->engine = std::make_unique<scenario::Engine>(std::move(sc));
+  scenario_ = std::move(run);
+}
+
+void World::trigger(const std::string& name, const std::string& value) {
+  if (scenario_) scenario_->pending.push_back({name, value});
+}
+
+const scenario::Engine* World::scenarioEngine() const { return scenario_ ? scenario_->engine.get() : nullptr; }
+long World::scenarioUnappliedActions() const { return scenario_ ? scenario_->unapplied : 0; }
+
+void World::stepScenario() {
+  ScenarioRun& S = *scenario_;
+  for (const ScenarioRun::Frame& f : S.frames)
+    if (!mannequins_[static_cast<std::size_t>(f.mannequin)]->calibrated) return;  // no targets yet
+  scenario::Observation& obs = S.obs;
+  obs.time = time();
+  for (std::size_t i = 0; i < S.frames.size(); ++i) {
+    const DrivenFrame& st = mannequins_[static_cast<std::size_t>(S.frames[i].mannequin)]->frames[S.frames[i].driven];
+    obs.frames[i].pose = st.actual;
+    obs.frames[i].target = st.target;  // the mocap target driveTargets just set
+    obs.frames[i].force.setZero();
+  }
+  for (std::size_t k = 0; k < S.objects.size(); ++k) {
+    const RigidObject& o = object(S.objects[k]);
+    obs.objects[k].pose = o.pose();
+    for (double& v : obs.objects[k].values) v = o.angle();
+  }
+  obs.triggers.swap(S.pending);
+  S.pending.clear();
+  const scenario::StepResult& r = S.engine->step(obs);
+  const scenario::Scenario& sc = S.engine->scenario();
+  for (const scenario::ActionCommand& a : r.actions) {
+    const scenario::Action& act = *a.action;
+    const bool frame_ok = act.frame >= 0 && static_cast<std::size_t>(act.frame) < S.frames.size();
+    if (act.kind == scenario::Action::Kind::kGrasp && frame_ok && act.object >= 0 && physics_) {
+      const ScenarioRun::Frame& f = S.frames[static_cast<std::size_t>(act.frame)];
+      S.grasp_handle[static_cast<std::size_t>(act.frame)] =
+          grasp(f.mannequin, sc.frames[static_cast<std::size_t>(act.frame)].frame, sc.objects[static_cast<std::size_t>(act.object)].name);
+    } else if (act.kind == scenario::Action::Kind::kRelease && frame_ok) {
+      int& h = S.grasp_handle[static_cast<std::size_t>(act.frame)];
+      if (h >= 0) release(h);
+      h = -1;
+    } else {
+      ++S.unapplied;
+    }
+  }
+  for (std::size_t i = 0; i < S.frames.size(); ++i) {
+    const scenario::FrameCommand& c = r.frames[i];
+    Mannequin& m = *mannequins_[static_cast<std::size_t>(S.frames[i].mannequin)];
+    DrivenFrame& st = m.frames[S.frames[i].driven];
+    st.target = c.setpoint.pose;
+    // the setpoint's world twist (ω, v) as the target's body twist (Rᵀω, Rᵀv), fed forward
+    math::Vector6 V;
+    V.head<3>() = c.setpoint.pose.R.transpose() * c.setpoint.twist.head<3>();
+    V.tail<3>() = c.setpoint.pose.R.transpose() * c.setpoint.twist.tail<3>();
+    const double w = c.mode == scenario::ControlMode::kFree ? m.weights[S.frames[i].driven] : 1.0;
+    m.stepper->setTarget(static_cast<int>(S.frames[i].driven), st.target, V, w);
+  }
+}
 
 World::Source* World::findSource(const std::string& name) {
   for (auto& src : sources_)
@@ -796,6 +903,7 @@ bool World::step() {
   const double dt = config_.step;
   bool ok = true;
   for (auto& mp : mannequins_) driveTargets(*mp, dt);
+  if (scenario_) stepScenario();
   if (physics_) {
     ok = physicsStep();
     diagnostics_.nan = !ok;

@@ -44,6 +44,11 @@
 #include "mannequin/sim/tracker.hpp"
 #include "mannequin/skeleton/model.hpp"
 
+namespace mannequin::scenario {
+class Engine;
+struct Scenario;
+}  // namespace mannequin::scenario
+
 namespace mannequin::sim {
 
 /// A control frame driven by a mocap body.
@@ -241,6 +246,20 @@ class World {
   /// object and that mannequin's segments are ignored while held. Returns a handle ≥ 0, or −1 when the
   /// object is already held by this frame's body or every grasp slot is used.
   /// \throws std::invalid_argument naming an unknown mannequin, frame or object, or physics off.
+  /// Runs a scenario's state machine in the loop (thesis 4.1.2, libs/scenario): every step, once all its
+  /// mannequins are calibrated, its engine sees the commanded control frames (simulated pose, mocap target;
+  /// contact force not reported yet: zero) and its objects (pose; the value `angle` of a hinged object),
+  /// and its setpoints replace those frames' targets — free: the mocap target; constrained: projected on
+  /// the mechanism; autonomous: the trajectory — velocity-continuous across switches (their world twist
+  /// fed forward as the targets' body twist). Its grasp/release actions call grasp()/release() (physics
+  /// on); the others (attach/detach guide, set gains) are counted in scenarioUnappliedActions(), not applied.
+  /// \throws std::invalid_argument naming a mannequin, frame, object or value the World lacks.
+  void setScenario(scenario::Scenario s);
+  /// An operator trigger, seen by the scenario at the next step.
+  void trigger(const std::string& name, const std::string& value = "");
+  /// The engine (state, time in state, context stack), nullptr without a scenario.
+  const scenario::Engine* scenarioEngine() const;
+  long scenarioUnappliedActions() const;
   int grasp(int m, const std::string& frame, const std::string& object);
   /// Releases a grasp; false for an unknown handle.
   bool release(int handle);
@@ -270,6 +289,9 @@ class World {
   SimConfig config_;
   std::vector<std::unique_ptr<Source>> sources_;  // "" first
   std::uint64_t steps_ = 0, failed_steps_ = 0;
+  struct ScenarioRun;
+  std::unique_ptr<ScenarioRun> scenario_;
+  void stepScenario();
   std::unique_ptr<Physics> physics_;
   StepDiagnostics diagnostics_;
   std::vector<MannequinDiagnostics> mannequin_diagnostics_;
