@@ -154,7 +154,8 @@ TEST_F(Curve, UnlistedClientGetsNothingAndIsLoggedAndCounted) {
   const std::string text = log.text();
   EXPECT_NE(text.find("refused CURVE client key " + other.public_key), std::string::npos) << text;
   EXPECT_NE(text.find("127.0.0.1"), std::string::npos) << text;  // the peer address
-  EXPECT_EQ(text.find(listed.public_key), std::string::npos) << "the listed key was refused: " << text;
+  EXPECT_EQ(text.find("refused CURVE client key " + listed.public_key), std::string::npos) << "the listed key was refused: " << text;
+  EXPECT_NE(text.find("admitted CURVE client " + listed.public_key), std::string::npos) << text;
 }
 
 TEST_F(Curve, ClientWithAWrongServerKeyGetsNothing) {

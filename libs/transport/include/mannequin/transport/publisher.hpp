@@ -36,7 +36,7 @@ struct PublisherOptions {
   std::vector<std::string> endpoints;   ///< where to bind (at least one)
   int send_hwm = 1000;                  ///< messages queued per subscriber before dropping
   bool deterministic = false;           ///< Header.send_time_ns = 0 (byte-identical output in replay)
-  std::optional<CurveServerOptions> curve;  ///< CURVE server with a ZAP key check (unset: plaintext)
+  std::optional<CurveServerOptions> curve = std::nullopt;  ///< CURVE server with a ZAP key check (unset: plaintext)
 };
 
 namespace detail {

@@ -42,7 +42,7 @@ struct SubscriberOptions {
   std::vector<std::string> endpoints; ///< publishers to connect to (may be empty; see connect())
   int receive_hwm = 1000;             ///< messages queued before ZeroMQ drops (seen as sequence gaps)
   int max_drain = 10000;              ///< messages read per poll() at most (keeps a loop responsive)
-  std::optional<CurveClientOptions> curve;  ///< CURVE client keys (unset: plaintext)
+  std::optional<CurveClientOptions> curve = std::nullopt;  ///< CURVE client keys (unset: plaintext)
 };
 
 /// Arrival information handed to handlers that want it.
