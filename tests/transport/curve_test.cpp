@@ -192,6 +192,20 @@ TEST_F(Curve, UnlistedPublisherCannotFeedACurveSubscriberOfMocapFrames) {
   EXPECT_EQ(rogue.curveAdmissions(), 0u);  // the subscriber never completed a handshake with it
 }
 
+TEST_F(Curve, PlaintextSocketsOfTheSameContextAreUnaffected) {
+  start();  // the context now has a ZAP handler
+  TempDir dir;
+  Publisher plain_tcp(ctx, PublisherOptions{"mocap", {"tcp://127.0.0.1:0"}});
+  Publisher plain_ipc(ctx, PublisherOptions{"mocap", {dir.ipc("plain")}});
+  Subscriber tcp_sub(ctx, SubscriberOptions{"tcp", {plain_tcp.boundEndpoints().at(0)}});
+  Subscriber ipc_sub(ctx, SubscriberOptions{"ipc", {dir.ipc("plain")}});
+  Counter tcp(tcp_sub), ipc(ipc_sub);
+  ASSERT_TRUE(pump({pub.get(), &plain_tcp, &plain_ipc}, {good.get(), &tcp, &ipc}, kDeadline,
+                   [&] { return good->got >= 20 && tcp.got >= 20 && ipc.got >= 20; }))
+      << "CURVE " << good->got << ", plaintext tcp " << tcp.got << ", ipc " << ipc.got;
+  EXPECT_EQ(pub->curveRefusals(), 0u);
+}
+
 TEST_F(Curve, BadKeysAreRefusedAtConstruction) {
   EXPECT_THROW(Publisher(ctx, curvePublisher("p", CurveKeyPair{"x", "short"}, {})), std::invalid_argument);
   EXPECT_THROW(Publisher(ctx, curvePublisher("p", server, {"not-a-key"})), std::invalid_argument);
