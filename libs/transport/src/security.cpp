@@ -69,8 +69,9 @@ std::string readKeyFile(const std::string& path, bool secret) {
     const auto e = line.find_last_not_of(" \t\r");
     const std::string key = line.substr(b, e - b + 1);
     if (!isZ85Key(key))
-      throw std::runtime_error(fmt::format("{}:{}: not a Z85 CURVE key (expected 40 characters, got {})", path, number,
-                                           key.size()));
+      throw std::runtime_error(key.size() == 40 ? fmt::format("{}:{}: not a Z85 CURVE key (40 characters that do not decode)", path, number)
+                                                : fmt::format("{}:{}: not a Z85 CURVE key (expected 40 characters, got {})", path,
+                                                              number, key.size()));
     return key;
   }
   throw std::runtime_error(path + ": no key in the file");
