@@ -6,6 +6,7 @@
 #include <stdexcept>
 
 #include "mannequin/transport/clock.hpp"
+#include "zap.hpp"
 
 namespace mannequin::transport {
 
@@ -37,6 +38,18 @@ Publisher::Publisher(zmq::context_t& context, PublisherOptions options)
   socket_.set(zmq::sockopt::sndhwm, options_.send_hwm);
   socket_.set(zmq::sockopt::linger, 0);
   socket_.set(zmq::sockopt::xpub_verbose, 1);
+  if (options_.curve) {
+    const CurveServerOptions& c = *options_.curve;
+    const std::string who = "publisher '" + options_.source + "': ";
+    if (!isZ85Key(c.secret_key)) throw std::invalid_argument(who + "CURVE secret key is not a Z85 key (40 characters)");
+    for (const std::string& k : c.authorized_keys)
+      if (!isZ85Key(k)) throw std::invalid_argument(who + "authorized key '" + k + "' is not a Z85 key (40 characters)");
+    auto handler = detail::ZapHandler::of(context);  // bound before this socket binds: no handshake goes unchecked
+    zap_ = std::make_shared<detail::ZapDomain>(handler, handler->addDomain(options_.source, c.authorized_keys));
+    socket_.set(zmq::sockopt::zap_domain, zap_->name);
+    socket_.set(zmq::sockopt::curve_server, 1);
+    socket_.set(zmq::sockopt::curve_secretkey, c.secret_key);
+  }
   for (const std::string& ep : options_.endpoints) {
     const std::string normalized = normalizeEndpoint(ep);
     try {
@@ -47,6 +60,9 @@ Publisher::Publisher(zmq::context_t& context, PublisherOptions options)
     bound_.push_back(socket_.get(zmq::sockopt::last_endpoint));
   }
 }
+
+std::uint64_t Publisher::curveRefusals() const { return zap_ ? zap_->handler->refusals(zap_->name) : 0; }
+std::uint64_t Publisher::curveAdmissions() const { return zap_ ? zap_->handler->accepted(zap_->name) : 0; }
 
 Publisher::TopicState& Publisher::state(std::string_view topic) {
   auto it = topics_.find(std::string(topic));

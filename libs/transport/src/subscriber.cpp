@@ -27,6 +27,16 @@ Subscriber::Subscriber(zmq::context_t& context, SubscriberOptions options)
     : options_(std::move(options)), socket_(context, zmq::socket_type::sub) {
   socket_.set(zmq::sockopt::rcvhwm, options_.receive_hwm);
   socket_.set(zmq::sockopt::linger, 0);
+  if (options_.curve) {
+    const CurveClientOptions& c = *options_.curve;
+    const std::string who = "subscriber '" + options_.name + "': CURVE ";
+    if (!isZ85Key(c.public_key)) throw std::invalid_argument(who + "public key is not a Z85 key (40 characters)");
+    if (!isZ85Key(c.secret_key)) throw std::invalid_argument(who + "secret key is not a Z85 key (40 characters)");
+    if (!isZ85Key(c.server_public_key)) throw std::invalid_argument(who + "server public key is not a Z85 key (40 characters)");
+    socket_.set(zmq::sockopt::curve_serverkey, c.server_public_key);
+    socket_.set(zmq::sockopt::curve_publickey, c.public_key);
+    socket_.set(zmq::sockopt::curve_secretkey, c.secret_key);
+  }
   const auto eps = options_.endpoints;
   for (const std::string& ep : eps) connect(ep);
 }

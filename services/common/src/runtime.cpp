@@ -3,6 +3,8 @@
 #include "mannequin/core/clock.hpp"
 #include "mannequin/core/main.hpp"
 
+#include <filesystem>
+
 namespace mannequin::service {
 
 void addCommonOptions(CLI::App& app, CommonOptions& o) {
@@ -44,7 +46,75 @@ Endpoints resolveEndpoints(const CommonOptions& o, const core::ConfigNode& confi
   if (e.publish.empty()) throw core::ConfigError(o.config + ": no publish endpoint (config 'publish' or --publish)");
   e.connect = o.connect;
   if (e.connect.empty() && config.has("connect")) e.connect = config["connect"].strings();
+  e.security = readSecurity(config, !e.connect.empty());
   return e;
+}
+
+namespace {
+// a path of the config, relative to the config file's directory
+std::string besideConfig(const core::ConfigNode& node) {
+  const std::string path = node.str();
+  if (path.empty()) node.fail("empty path");
+  const std::filesystem::path p(path);
+  if (p.is_absolute()) return path;
+  return (std::filesystem::path(node.file()).parent_path() / p).lexically_normal().string();
+}
+
+std::string keyFrom(const core::ConfigNode& node, bool secret) {
+  const std::string path = besideConfig(node);
+  try {
+    return transport::readKeyFile(path, secret);
+  } catch (const std::exception& e) {
+    node.fail(e.what());
+  }
+}
+}  // namespace
+
+Security readSecurity(const core::ConfigNode& config, bool connects) {
+  Security s;
+  const auto section = config.find("security");
+  if (!section) return s;
+  if (!section->isMap()) section->fail("expected a map (secret_key_file, public_key_file, server_public_key_file, authorized_keys)");
+  section->allowOnly({"secret_key_file", "public_key_file", "server_public_key_file", "authorized_keys"});
+  if (!transport::hasCurve()) section->fail("this libzmq has no CURVE support");
+  const core::ConfigNode secret_node = (*section)["secret_key_file"];
+  const std::string secret = keyFrom(secret_node, true);
+  const std::string public_key = transport::curvePublicKey(secret);
+  if (const auto p = section->find("public_key_file"))
+    if (keyFrom(*p, false) != public_key) p->fail("not the public key of " + besideConfig(secret_node));
+
+  transport::CurveServerOptions server;
+  server.secret_key = secret;
+  const core::ConfigNode listed = (*section)["authorized_keys"];
+  const std::vector<core::ConfigNode> entries = listed.isSequence() ? listed.items() : std::vector<core::ConfigNode>{listed};
+  for (const core::ConfigNode& entry : entries) {
+    const std::string text = entry.str();
+    server.authorized_keys.push_back(transport::isZ85Key(text) ? text : keyFrom(entry, false));
+  }
+  s.server = std::move(server);
+
+  if (const auto sp = section->find("server_public_key_file")) {
+    s.client = transport::CurveClientOptions{public_key, secret, keyFrom(*sp, false)};
+  } else if (connects) {
+    section->fail("missing key 'server_public_key_file' (the service connects to publishers)");
+  }
+  return s;
+}
+
+transport::PublisherOptions publisherOptions(const Endpoints& e) {
+  transport::PublisherOptions o;
+  o.source = e.name;
+  o.endpoints = e.publish;
+  o.curve = e.security.server;
+  return o;
+}
+
+transport::SubscriberOptions subscriberOptions(const Endpoints& e) {
+  transport::SubscriberOptions o;
+  o.name = e.name;
+  o.endpoints = e.connect;
+  o.curve = e.security.client;
+  return o;
 }
 
 ServiceLoop::ServiceLoop(transport::HealthReporter& health, const std::atomic<bool>& stop, double duration_s)

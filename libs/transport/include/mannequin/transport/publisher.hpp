@@ -12,8 +12,12 @@
 ///   (the XPUB socket reports each one, verbose), the last payload is sent again at once. Subscribers
 ///   drop the repeat as a duplicate if they already had it. Subscriptions are read by poll() and at
 ///   every publish(); a service calls poll() in its loop.
+/// - CURVE (optional, `curve`): the publisher is a CURVE server admitting only the listed client keys
+///   (security.hpp); unset, nothing changes (plaintext, anyone may subscribe).
 /// Not thread-safe (one thread owns a publisher, like any ZeroMQ socket).
 #include <cstdint>
+#include <memory>
+#include <optional>
 #include <string>
 #include <string_view>
 #include <unordered_map>
@@ -22,6 +26,7 @@
 #include <zmq.hpp>
 
 #include "mannequin/transport/counters.hpp"
+#include "mannequin/transport/security.hpp"
 #include "mannequin/transport/topics.hpp"
 
 namespace mannequin::transport {
@@ -31,11 +36,17 @@ struct PublisherOptions {
   std::vector<std::string> endpoints;   ///< where to bind (at least one)
   int send_hwm = 1000;                  ///< messages queued per subscriber before dropping
   bool deterministic = false;           ///< Header.send_time_ns = 0 (byte-identical output in replay)
+  std::optional<CurveServerOptions> curve = std::nullopt;  ///< CURVE server with a ZAP key check (unset: plaintext)
 };
+
+namespace detail {
+struct ZapDomain;
+}
 
 class Publisher {
  public:
   /// Binds every endpoint. \throws std::runtime_error naming the endpoint that cannot be bound.
+  /// \throws std::invalid_argument for a CURVE key that is not Z85.
   Publisher(zmq::context_t& context, PublisherOptions options);
 
   /// Fills msg.header (schema version, sequence, source, send time; keeps stamp_ns) and sends it.
@@ -60,12 +71,17 @@ class Publisher {
   std::vector<TopicCounters> counters() const;
   /// Number of subscriptions seen (subscribe messages, including repeats).
   std::uint64_t subscriptions() const { return subscriptions_; }
+  /// CURVE: client handshakes refused (key not listed) and admitted by the ZAP handler (0 without CURVE).
+  std::uint64_t curveRefusals() const;
+  std::uint64_t curveAdmissions() const;
+  bool curve() const { return zap_ != nullptr; }
 
   /// Fills a header as publish() does, without sending (for tests and tools).
   void fillHeader(std::string_view topic, v1::Header& header);
 
  private:
   PublisherOptions options_;
+  std::shared_ptr<detail::ZapDomain> zap_;  // before socket_: outlives it (its ZAP handler too)
   zmq::socket_t socket_;
   std::vector<std::string> bound_;
   struct TopicState {

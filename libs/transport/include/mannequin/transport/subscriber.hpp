@@ -13,8 +13,11 @@
 /// Anything else is counted (TopicCounters::malformed, unknownTopics()) and logged at most once per
 /// second per topic and reason — it never throws out of poll() and never reaches a handler.
 /// Handlers that throw are caught, logged (rate-limited) and counted in handlerErrors().
+/// CURVE (optional, `curve`): the subscriber is a CURVE client (its key pair, the publishers' public
+/// key; security.hpp); a publisher with another key, or one not listing this key, sends it nothing.
 /// Not thread-safe.
 #include <chrono>
+#include <optional>
 #include <cstdint>
 #include <functional>
 #include <memory>
@@ -29,6 +32,7 @@
 
 #include "mannequin/transport/counters.hpp"
 #include "mannequin/transport/log_limiter.hpp"
+#include "mannequin/transport/security.hpp"
 #include "mannequin/transport/topics.hpp"
 
 namespace mannequin::transport {
@@ -38,6 +42,7 @@ struct SubscriberOptions {
   std::vector<std::string> endpoints; ///< publishers to connect to (may be empty; see connect())
   int receive_hwm = 1000;             ///< messages queued before ZeroMQ drops (seen as sequence gaps)
   int max_drain = 10000;              ///< messages read per poll() at most (keeps a loop responsive)
+  std::optional<CurveClientOptions> curve = std::nullopt;  ///< CURVE client keys (unset: plaintext)
 };
 
 /// Arrival information handed to handlers that want it.
@@ -48,7 +53,8 @@ struct Received {
 
 class Subscriber {
  public:
-  /// Connects to every endpoint. \throws std::runtime_error naming an endpoint ZeroMQ rejects.
+  /// Connects to every endpoint. \throws std::runtime_error naming an endpoint ZeroMQ rejects,
+  /// std::invalid_argument for a CURVE key that is not Z85.
   Subscriber(zmq::context_t& context, SubscriberOptions options);
 
   /// Connects to one more publisher.

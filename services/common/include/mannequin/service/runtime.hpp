@@ -5,6 +5,7 @@
 #include <atomic>
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -13,6 +14,9 @@
 
 #include "mannequin/core/config.hpp"
 #include "mannequin/transport/health.hpp"
+#include "mannequin/transport/publisher.hpp"
+#include "mannequin/transport/security.hpp"
+#include "mannequin/transport/subscriber.hpp"
 
 namespace mannequin::service {
 
@@ -44,14 +48,38 @@ struct Cli {
 /// \throws core::ConfigError.
 core::ConfigNode loadConfig(const CommonOptions& options, const std::function<void(YAML::Node&)>& overrides = {});
 
-/// Who a service is on the network: the command line wins over the config (`name`, `publish`, `connect`).
+/// A service's CURVE keys, from its config's `security` section (docs/cluster.md, Security):
+///   security:
+///     secret_key_file: keys/sim.key_secret        # required; mode 0600
+///     public_key_file: keys/sim.key               # optional; must be the secret's public key
+///     server_public_key_file: keys/cluster.key    # the publishers' key (required with `connect`)
+///     authorized_keys: [keys/render1.key, "Z85..."]  # clients admitted by this service's publisher
+/// Relative paths are relative to the config file's directory. No section: plaintext, as before.
+struct Security {
+  std::optional<transport::CurveServerOptions> server;  ///< for the service's publisher
+  std::optional<transport::CurveClientOptions> client;  ///< for the service's subscriber
+  bool enabled() const { return server.has_value(); }
+};
+/// Reads `security` (absent: disabled). `connects`: the service has publishers to connect to.
+/// \throws core::ConfigError "FILE:LINE: field 'security.x': ..." naming the config entry of a bad,
+/// missing or world-readable key file or a bad key.
+Security readSecurity(const core::ConfigNode& config, bool connects);
+
+/// Who a service is on the network: the command line wins over the config (`name`, `publish`, `connect`);
+/// its CURVE keys come from the config's `security` section.
 struct Endpoints {
   std::string name;
   std::vector<std::string> publish;
   std::vector<std::string> connect;
+  Security security;
 };
-/// \throws core::ConfigError when there is no endpoint to publish on.
+/// \throws core::ConfigError when there is no endpoint to publish on or the `security` section is bad.
 Endpoints resolveEndpoints(const CommonOptions& options, const core::ConfigNode& config, const std::string& default_name);
+
+/// The publisher of a service: its name, publish endpoints and CURVE server keys (if any).
+transport::PublisherOptions publisherOptions(const Endpoints& endpoints);
+/// The subscriber of a service: its name, connect endpoints and CURVE client keys (if any).
+transport::SubscriberOptions subscriberOptions(const Endpoints& endpoints);
 
 /// The loop of every service: health RUNNING and a heartbeat at start; then, until a stop signal,
 /// `duration` seconds (0: no limit) or the iteration returning false, one iteration (which waits on its
