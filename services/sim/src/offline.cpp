@@ -131,7 +131,16 @@ OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
       raw["c3d"]["mapping"] = options.c3d_mapping;
       raw["c3d"]["loop"] = false;
       raw["c3d"]["paced"] = false;
-      source_ = mocap::makeSource(core::ConfigNode(raw, "--mocap " + options.mocap));
+      try {
+        source_ = mocap::makeSource(core::ConfigNode(raw, "--mocap"));
+      } catch (const std::exception& e) {  // the C3D file's (or the mapping's) own message, not the in-memory config's
+        std::string what = e.what();
+        if (what.rfind("--mocap:", 0) == 0) {
+          const std::size_t field = what.find("': ");
+          what = field == std::string::npos ? what : what.substr(field + 3);
+        }
+        throw OfflineInputError(what);
+      }
       const auto* cs = dynamic_cast<const mocap::C3dSource*>(source_.get());
       std::set<std::string> bodies;
       for (const mocap::C3dCluster& b : mocap::loadC3dMapping(core::findData(options.c3d_mapping)).bodies) bodies.insert(b.body);
