@@ -219,6 +219,8 @@ TEST(BatchTool, CompareOnTheC3dCaptureGivesTwoColumns) {
   EXPECT_TRUE(fs::exists(dir / "male_50th" / "run.mcap"));
   EXPECT_TRUE(fs::exists(dir / "female_05th" / "run.mcap"));
   EXPECT_FALSE(fs::exists(dir / "run.mcap"));
+  for (const char* m : {"male_50th", "female_05th"})  // 2 s of sim.world at 60 Hz each
+    EXPECT_EQ(mannequin::recording::McapReader::open((dir / m / "run.mcap").string()).readAll().size(), 120u) << m;
   auto [s, out] = python(kSummaryCheck, (dir / "summary.json").string() + " male_50th,female_05th 2 foot_l,foot_r,pelvis 1");
   EXPECT_EQ(s, 0) << out;
   std::tie(s, out) = python(kHtmlCheck, (dir / "report.html").string() + " male_50th,female_05th");
