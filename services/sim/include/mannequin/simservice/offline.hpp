@@ -1,0 +1,125 @@
+#pragma once
+/// \file offline.hpp
+/// \brief The sim service's World run offline, in one process (no network): a sim config, a capture
+/// (the config's `mocap` config, or a BVH / C3D file replacing its capture), stepped as fast as
+/// possible in replay semantics (deterministic), the step diagnostics and the postures' ergonomic
+/// scores accumulated, optionally the sim.world messages written to an MCAP file. Shared by
+/// mannequin-simulate and mannequin-batch (tools/simulate, tools/batch).
+#include <array>
+#include <cstdint>
+#include <functional>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "mannequin/ergonomics/ergonomics.hpp"
+#include "mannequin/mocap/source.hpp"
+#include "mannequin/sim/world.hpp"
+#include "mannequin/simservice/config.hpp"
+
+namespace mannequin::simservice {
+
+/// Per mannequin, the postures' ergonomic scores over the run (RULA and REBA of the worse side, sampled
+/// at the world rate once calibrated; libs/ergonomics with its default task input: no load, not static,
+/// not repeated — what a capture cannot say).
+struct ErgonomicsSummary {
+  std::string mannequin;
+  int rula_max = 0, reba_max = 0;
+  std::array<double, 4> rula_time_s{};  ///< at RULA action level 1..4
+  std::array<double, 5> reba_time_s{};  ///< at REBA action level 0..4
+  long long samples = 0;
+  long long failures = 0;  ///< postures the evaluator refused (non-finite q)
+};
+
+/// What a run measured (mannequin-simulate's --json keys).
+struct OfflineSummary {
+  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
+  long long frames = 0, steps = 0, nan_steps = 0, lcp_failures = 0, worlds = 0;
+  double sim_time_s = 0, wall_s = 0;
+  double max_penetration_m = 0;
+  int max_contacts = 0;
+  double contact_sum = 0;
+  long long foot_contact_steps = 0;
+  double min_balance_distance_m = kNaN;  // NaN: never a support polygon
+  double min_force_margin_n = kNaN;      // NaN: never evaluated (physics.force_margin_period 0)
+  double force_margin_sum = 0;
+  long long force_margin_samples = 0;
+  double worst_joint_limit_excess_rad = 0;
+  double hand_error_sum = 0, foot_error_sum = 0;
+  long long hand_samples = 0, foot_samples = 0;
+  bool physics = false;
+  std::vector<ErgonomicsSummary> ergonomics;
+
+  double meanContacts() const { return steps > 0 ? contact_sum / static_cast<double>(steps) : 0.0; }
+  double footContactFraction() const {
+    return steps > 0 ? static_cast<double>(foot_contact_steps) / static_cast<double>(steps) : 0.0;
+  }
+  double meanHandError() const { return hand_samples > 0 ? hand_error_sum / static_cast<double>(hand_samples) : kNaN; }
+  double meanFootError() const { return foot_samples > 0 ? foot_error_sum / static_cast<double>(foot_samples) : kNaN; }
+  double realtimeFactor() const { return wall_s > 0 ? sim_time_s / wall_s : kNaN; }
+  double meanForceMargin() const {
+    return force_margin_samples > 0 ? force_margin_sum / static_cast<double>(force_margin_samples) : kNaN;
+  }
+};
+
+/// A bad input file (config, mannequin, scene, capture, a non-finite sample): the message names the
+/// FILE (and line or frame). Tools exit 2 on it.
+class OfflineInputError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+struct OfflineOptions {
+  std::string config = "configs/sim/sim_demo.yaml";  ///< sim config (core::findData)
+  /// A capture replacing the one of the sim config's `mocap` config: a .bvh (the mocap config's map and
+  /// bodies kept), or a .c3d (source: c3d with `c3d_mapping`; the mannequins' control frames reduced
+  /// to the mapping's bodies). "" keeps the mocap config's.
+  std::string mocap;
+  std::string c3d_mapping = "configs/mappings/c3d_sample01.yaml";
+  std::string mannequin;  ///< mannequin config for every mannequin ("" keeps the sim config's)
+  std::string scene;      ///< scene file: turns the physics on with this scene ("" keeps the config's)
+  double duration = -1;   ///< s of simulation (≤ 0: the whole capture)
+  std::string out;        ///< MCAP file of the sim.world messages ("" none)
+  bool progress = false;  ///< a progress bar with ETA on stderr
+  std::string progress_label;
+};
+
+/// Called once per world sample (world_rate), after the summary's ergonomics of that sample: the World,
+/// and per mannequin the sample's assessment (nullptr when not calibrated or refused).
+using SampleHook = std::function<void(const sim::World&, const std::vector<const ergonomics::Assessment*>&)>;
+/// Called after each step with the step's wall time (s).
+using StepHook = std::function<void(const sim::World&, double step_wall_s)>;
+
+class OfflineRun {
+ public:
+  /// Loads the config, capture, mannequins and scene.
+  /// \throws OfflineInputError naming FILE:LINE (or FILE: frame) of what is bad.
+  explicit OfflineRun(const OfflineOptions& options);
+  ~OfflineRun();
+  OfflineRun(const OfflineRun&) = delete;
+  OfflineRun& operator=(const OfflineRun&) = delete;
+
+  /// Steps the whole capture (or `duration`). \throws OfflineInputError for a non-finite capture sample
+  /// (FILE: frame N: body B) — the MCAP file (if any) is then removed.
+  OfflineSummary run(const SampleHook& on_sample = {}, const StepHook& on_step = {});
+
+  const SimServiceConfig& config() const { return config_; }
+  const sim::World& world() const { return *world_; }
+  /// The capture's length in s (0 when the source cannot say).
+  double captureLength() const { return capture_length_s_; }
+  /// The capture file played.
+  const std::string& captureFile() const { return capture_file_; }
+
+ private:
+  OfflineOptions options_;
+  SimServiceConfig config_;
+  std::unique_ptr<mocap::Source> source_;
+  std::unique_ptr<sim::World> world_;
+  std::vector<ergonomics::Evaluator> evaluators_;
+  double capture_length_s_ = 0;
+  std::string capture_file_;
+};
+
+}  // namespace mannequin::simservice

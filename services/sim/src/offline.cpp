@@ -1,0 +1,312 @@
+// The offline run of the sim service's World (mannequin-simulate, mannequin-batch): see offline.hpp.
+#include "mannequin/simservice/offline.hpp"
+
+#include <fmt/format.h>
+#include <spdlog/spdlog.h>
+#include <yaml-cpp/yaml.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+#include <optional>
+#include <set>
+
+#include "mannequin/collision/scene.hpp"
+#include "mannequin/core/paths.hpp"
+#include "mannequin/mocap/bvh_source.hpp"
+#include "mannequin/mocap/c3d_source.hpp"
+#include "mannequin/proto/schema.hpp"
+#include "mannequin/recording/mcap_writer.hpp"
+#include "mannequin/simservice/messages.hpp"
+#include "mannequin/transport/convert.hpp"
+#include "mannequin/transport/topics.hpp"
+
+namespace mannequin::simservice {
+
+namespace {
+
+bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
+
+bool endsWith(std::string s, const std::string& suffix) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+/// After each step: the diagnostics into the summary (no allocation).
+void accumulate(const sim::World& world, bool ok, OfflineSummary& s) {
+  ++s.steps;
+  const sim::StepDiagnostics& d = world.diagnostics();
+  if (!ok || d.nan) ++s.nan_steps;
+  if (world.physics()) {
+    s.max_penetration_m = std::max(s.max_penetration_m, d.max_penetration_m);
+    s.max_contacts = std::max(s.max_contacts, d.contacts);
+    s.contact_sum += d.contacts;
+  }
+  bool foot = false;
+  for (int m = 0; m < world.numMannequins(); ++m) {
+    if (world.physics()) {
+      const sim::MannequinDiagnostics& md = world.mannequinDiagnostics(m);
+      foot = foot || md.foot_contact;
+      if (std::isfinite(md.balance_distance_m) &&
+          (!std::isfinite(s.min_balance_distance_m) || md.balance_distance_m < s.min_balance_distance_m))
+        s.min_balance_distance_m = md.balance_distance_m;
+      s.worst_joint_limit_excess_rad = std::max(s.worst_joint_limit_excess_rad, md.worst_joint_limit_excess_rad);
+      if (std::isfinite(md.force_margin_n)) {
+        if (!(md.force_margin_n >= s.min_force_margin_n)) s.min_force_margin_n = md.force_margin_n;  // NaN: the first
+        s.force_margin_sum += md.force_margin_n;
+        ++s.force_margin_samples;
+      }
+    }
+    if (!world.calibrated(m)) continue;
+    for (const sim::DrivenFrame& f : world.controlFrames(m)) {
+      if (!f.tracked) continue;
+      if (startsWith(f.frame, "hand_")) {
+        s.hand_error_sum += f.position_error;
+        ++s.hand_samples;
+      } else if (startsWith(f.frame, "foot_")) {
+        s.foot_error_sum += f.position_error;
+        ++s.foot_samples;
+      }
+    }
+  }
+  if (foot) ++s.foot_contact_steps;
+}
+
+/// A progress bar with ETA on stderr, redrawn at most every 0.1 s.
+class Progress {
+ public:
+  Progress(bool on, double total, std::string label) : on_(on), total_(total), label_(std::move(label)) {}
+  void update(double sim_time, double wall) {
+    if (!on_ || wall - last_ < 0.1) return;
+    last_ = wall;
+    const double f = total_ > 0 ? std::min(1.0, sim_time / total_) : 0.0;
+    const int width = 30, filled = static_cast<int>(f * width);
+    const double rate = wall > 0 ? sim_time / wall : 0.0;
+    const double eta = rate > 0 && total_ > 0 ? std::max(0.0, total_ - sim_time) / rate : 0.0;
+    std::fprintf(stderr, "\r%s[%s%s] %5.1f%%  %.2f / %.2f s  %.1fx real time  ETA %.0f s ", label_.c_str(),
+                 std::string(filled, '#').c_str(), std::string(width - filled, ' ').c_str(), 100 * f, sim_time, total_, rate,
+                 eta);
+    std::fflush(stderr);
+  }
+  void done() {
+    if (on_) std::fprintf(stderr, "\r%*s\r", 100, "");
+  }
+
+ private:
+  bool on_;
+  double total_, last_ = -1.0;
+  std::string label_;
+};
+
+}  // namespace
+
+OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
+  try {
+    config_ = loadSimConfig(core::findData(options.config));
+    SimServiceConfig& c = config_;
+    c.world.interpolation_delay = 0.0;  // frames fed up to each capture time (replay semantics)
+    c.mode = Mode::kReplay;
+    if (!options.mannequin.empty())
+      for (MannequinEntry& e : c.mannequins) {
+        e.config = core::findData(options.mannequin);
+        e.where.clear();
+      }
+    if (!options.scene.empty()) {
+      c.world.physics.scene = collision::loadScene(core::findData(options.scene));
+      c.world.physics.enabled = true;
+    }
+    if (c.collision.mode == CollisionMode::kService)
+      spdlog::info("collision: mode service needs mannequin-collision on the network: not used here{}",
+                   c.world.physics.enabled ? " (the physics queries its own collision world)" : "");
+
+    const bool c3d = !options.mocap.empty() && endsWith(options.mocap, ".c3d");
+    if (c3d) {
+      // a C3D lab capture: the mocap library's `source: c3d`, its marker clusters as rigid bodies; the
+      // mannequins driven by the control frames whose bodies the mapping has
+      YAML::Node raw;
+      raw["source"] = "c3d";
+      raw["c3d"]["file"] = options.mocap;
+      raw["c3d"]["mapping"] = options.c3d_mapping;
+      raw["c3d"]["loop"] = false;
+      raw["c3d"]["paced"] = false;
+      try {
+        source_ = mocap::makeSource(core::ConfigNode(raw, "--mocap"));
+      } catch (const std::exception& e) {  // the C3D file's (or the mapping's) own message, not the in-memory config's
+        std::string what = e.what();
+        if (what.rfind("--mocap:", 0) == 0) {
+          const std::size_t field = what.find("': ");
+          what = field == std::string::npos ? what : what.substr(field + 3);
+        }
+        throw OfflineInputError(what);
+      }
+      const auto* cs = dynamic_cast<const mocap::C3dSource*>(source_.get());
+      std::set<std::string> bodies;
+      for (const mocap::C3dCluster& b : mocap::loadC3dMapping(core::findData(options.c3d_mapping)).bodies) bodies.insert(b.body);
+      for (MannequinEntry& e : c.mannequins) {
+        std::vector<sim::ControlFrameSpec> kept;
+        for (const sim::ControlFrameSpec& f : e.frames)
+          if (bodies.count(f.body)) kept.push_back(f);
+        if (kept.empty())
+          throw OfflineInputError(fmt::format("{}: mannequin '{}': none of its control frames' bodies is in the C3D mapping {}",
+                                              options.config, e.name, options.c3d_mapping));
+        e.frames = std::move(kept);
+      }
+      if (cs && cs->c3d().rate > 0) capture_length_s_ = cs->c3d().frames_present / cs->c3d().rate;
+      capture_file_ = options.mocap;
+    } else {
+      // the sim config's `mocap` (a mocap service config), --mocap replacing its BVH file
+      const std::string mocap_path = c.mocap.empty() ? core::findData("configs/sim/mocap_demo.yaml") : c.mocap;
+      YAML::Node raw;
+      try {
+        raw = YAML::LoadFile(mocap_path);
+      } catch (const YAML::Exception& e) {
+        throw core::ConfigError(fmt::format("{}:{}: {}", mocap_path, e.mark.line + 1, e.msg));
+      }
+      if (!raw.IsMap()) throw core::ConfigError(mocap_path + ":1: a mocap config (a map with `source: bvh` and a `bvh` section)");
+      if (!raw["source"] || raw["source"].as<std::string>("") != "bvh" || !raw["bvh"]) {
+        const YAML::Mark at = raw["source"] ? raw["source"].Mark() : raw.Mark();
+        throw core::ConfigError(
+            fmt::format("{}:{}: field 'source': mannequin-simulate plays BVH captures (source: bvh with a bvh section)",
+                        mocap_path, at.line + 1));
+      }
+      if (!options.mocap.empty()) raw["bvh"]["file"] = options.mocap;
+      raw["bvh"]["loop"] = false;   // the capture once
+      raw["bvh"]["paced"] = false;  // as fast as asked for
+      capture_file_ = raw["bvh"]["file"].as<std::string>("");
+      source_ = mocap::makeSource(core::ConfigNode(raw, mocap_path));
+      if (const auto* b = dynamic_cast<const mocap::BvhSource*>(source_.get()))
+        capture_length_s_ = b->bvh().num_frames * b->bvh().frame_time / raw["bvh"]["rate"].as<double>(1.0);
+    }
+    world_ = std::make_unique<sim::World>(buildMannequins(c), c.world);
+  } catch (const OfflineInputError&) {
+    throw;
+  } catch (const std::exception& e) {  // a bad file: its FILE:LINE message
+    throw OfflineInputError(e.what());
+  }
+  for (int m = 0; m < world_->numMannequins(); ++m) {
+    try {
+      evaluators_.emplace_back(world_->model(m));
+    } catch (const std::invalid_argument& e) {  // a model without the mannequin's joints (not buildMannequin's)
+      throw OfflineInputError(fmt::format("{}: no ergonomic scores: {}", world_->name(m), e.what()));
+    }
+  }
+}
+
+OfflineRun::~OfflineRun() = default;
+
+OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_step) {
+  sim::World& world = *world_;
+  const SimServiceConfig& config = config_;
+  OfflineSummary s;
+  s.physics = world.physics();
+  for (int m = 0; m < world.numMannequins(); ++m) s.ergonomics.push_back({world.name(m)});
+
+  std::unique_ptr<recording::McapWriter> writer;
+  std::uint16_t channel = 0;
+  if (!options_.out.empty()) {
+    writer = std::make_unique<recording::McapWriter>(options_.out);
+    const std::uint16_t schema = writer->addSchema("mannequin.v1.WorldState", "protobuf",
+                                                   proto::fileDescriptorSet(v1::WorldState::descriptor()));
+    channel = writer->addChannel(std::string(transport::topics::kSimWorld.name), schema, "protobuf");
+  }
+  v1::WorldState msg;
+  std::string payload;
+  double world_phase = 0.0;
+  std::vector<ergonomics::Assessment> assessments(static_cast<std::size_t>(world.numMannequins()));
+  std::vector<const ergonomics::Assessment*> sampled(static_cast<std::size_t>(world.numMannequins()), nullptr);
+  const double dt = 1.0 / config.world_rate;
+  const auto sampleErgonomics = [&] {
+    for (int m = 0; m < world.numMannequins(); ++m) {
+      const auto i = static_cast<std::size_t>(m);
+      sampled[i] = nullptr;
+      if (!world.calibrated(m)) continue;
+      ErgonomicsSummary& e = s.ergonomics[i];
+      try {
+        assessments[i] = evaluators_[i].evaluate(world.q(m));
+        const ergonomics::Assessment& a = assessments[i];
+        const int rula = std::max(a.rula[0].grand, a.rula[1].grand), reba = std::max(a.reba[0].score, a.reba[1].score);
+        e.rula_max = std::max(e.rula_max, rula);
+        e.reba_max = std::max(e.reba_max, reba);
+        e.rula_time_s[static_cast<std::size_t>(ergonomics::rulaActionLevel(rula) - 1)] += dt;
+        e.reba_time_s[static_cast<std::size_t>(ergonomics::rebaActionLevel(reba))] += dt;
+        ++e.samples;
+        sampled[i] = &assessments[i];
+      } catch (const std::invalid_argument&) {
+        ++e.failures;
+      }
+    }
+  };
+  const auto publish = [&] {
+    world_phase += config.world_rate * config.world.step;
+    if (world_phase < 1.0 - 1e-9) return;
+    world_phase -= 1.0;
+    sampleErgonomics();
+    if (on_sample) on_sample(world, sampled);
+    if (!writer) return;
+    toWorldState(world, nullptr, false, true, msg);
+    v1::Header* h = msg.mutable_header();
+    h->set_schema_version(transport::kSchemaVersion);
+    h->set_sequence(static_cast<std::uint64_t>(++s.worlds));
+    h->set_source(config.name);
+    h->set_send_time_ns(0);  // deterministic
+    msg.SerializeToString(&payload);
+    const auto t = static_cast<recording::Timestamp>(h->stamp_ns());
+    writer->write(channel, static_cast<std::uint32_t>(s.worlds), t, t, payload);
+  };
+
+  const double total = options_.duration > 0 ? options_.duration : std::numeric_limits<double>::infinity();
+  const std::int64_t step_ns = std::llround(config.world.step * 1e9);
+  Progress progress(options_.progress, std::isfinite(total) ? std::min(total, capture_length_s_ > 0 ? capture_length_s_ : total)
+                                                            : capture_length_s_,
+                    options_.progress_label);
+  const auto t0 = std::chrono::steady_clock::now();
+  const auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
+  const std::vector<std::string> sources = world.mocapSources();  // "" first
+  bool done = false;
+  try {
+    while (!done && !source_->finished()) {
+      const std::optional<mocap::Frame> f = source_->next(std::chrono::microseconds(0));
+      if (!f) continue;
+      ++s.frames;
+      for (const mocap::Body& b : f->bodies)  // a NaN sample: the file and its frame, not a NaN world
+        if (b.tracked && !(b.pose.p.allFinite() && b.pose.R.allFinite()))
+          throw OfflineInputError(fmt::format("{}: frame {}: body '{}': non-finite sample", capture_file_,
+                                              f->frame_number, b.name));
+      // the one capture drives every mocap source the mannequins name (sim config `mocap_sources`)
+      for (const std::string& src : sources) {
+        world.addMocap(*f, src);
+        if (!world.anchored(src)) world.anchor(f->stamp_ns, src);
+      }
+      while (world.captureTimeNs(sources.front()) + step_ns <= f->stamp_ns) {
+        if (world.time() + 0.5 * config.world.step >= total) {
+          done = true;
+          break;
+        }
+        const double before = on_step ? wall() : 0.0;
+        const bool ok = world.step();
+        if (on_step) on_step(world, wall() - before);
+        accumulate(world, ok, s);
+        publish();
+        progress.update(world.time(), wall());
+      }
+    }
+  } catch (...) {
+    progress.done();
+    if (writer) {
+      writer.reset();
+      std::error_code ec;
+      std::filesystem::remove(options_.out, ec);
+    }
+    throw;
+  }
+  s.wall_s = wall();
+  progress.done();
+  s.sim_time_s = world.time();
+  if (const constraints::ConstraintSolver* cs = world.constraintSolver()) s.lcp_failures = cs->failures();
+  if (writer) writer->close();
+  return s;
+}
+
+}  // namespace mannequin::simservice
