@@ -53,7 +53,8 @@ class KeysTool : public ::testing::Test {
 
   ToolRun run(const std::string& args) {
     const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-    const std::string cmd = toolPath().string() + " " + args + " >" + out.string() + " 2>" + err.string();
+    // under timeout(1): a hung tool fails the test at the deadline instead of hanging ctest
+    const std::string cmd = "timeout 60 " + toolPath().string() + " " + args + " >" + out.string() + " 2>" + err.string();
     const int raw = std::system(cmd.c_str());
     ToolRun r;
     r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
