@@ -52,6 +52,10 @@ const VariationalBalanceResult& VariationalBalanceSolver::solve(const Variationa
   if (!(p.dq_weight > 0) || !std::isfinite(p.dq_weight)) return fail("dq_weight must be > 0 and finite");
   if (!(p.max_step > 0) || !std::isfinite(p.max_step)) return fail("max_step must be > 0 and finite");
   if (!(p.max_task_step > 0) || !std::isfinite(p.max_task_step)) return fail("max_task_step must be > 0 and finite");
+  if (p.margins_at_com && !p.com_margins.empty())
+    return fail("com_margins need margins_at_com off (a CoM-position margin is a CoM shift)");
+  if (p.dq_desired.size() != 0 && (p.dq_desired.size() != nv || !p.dq_desired.allFinite()))
+    return fail("dq_desired must be empty or have " + std::to_string(nv) + " finite entries");
   for (std::size_t i = 0; i < p.contacts.size(); ++i) {
     const BodyContact& c = p.contacts[i];
     if (c.joint < 0 || c.joint >= njoints) return fail("contact " + std::to_string(i) + ": no joint " + std::to_string(c.joint));
@@ -89,7 +93,7 @@ const VariationalBalanceResult& VariationalBalanceSolver::solve(const Variationa
   const int mc = static_cast<int>(p.contacts.size()), ma = p.edges, nf = mc * ma, n = nf + nv;
   detail::Equilibrium& eq = I.eq;
   eq.build(I.world, ma, model.totalMass(), p.gravity, p.external_wrench);  // (3.59) at x_com,k
-  eq.margins(p.com_margins, p.force_margins);                                // W' (3.89, 3.95)
+  eq.margins(p.com_margins, p.force_margins, !p.margins_at_com);              // W' (3.89, 3.95)
 
   // equality rows (3.102, 3.106)
   I.points_on.assign(p.held.size(), 0);
@@ -143,7 +147,10 @@ const VariationalBalanceResult& VariationalBalanceSolver::solve(const Variationa
   eq.forceWeights(I.world, ma, p.force_weight, p.alpha, qp_.B);
   qp_.f_pull = p.force_weight * eq.f_desired;
   qp_.y_weight.setConstant(nv, p.dq_weight);
-  qp_.y_desired.setZero(nv);
+  if (p.dq_desired.size() == nv)
+    qp_.y_desired = p.dq_desired;  // the internal control of (4.1): ‖δq − β δq_d‖
+  else
+    qp_.y_desired.setZero(nv);
   qp_.lower.setConstant(nv, -p.max_step);
   qp_.upper.setConstant(nv, p.max_step);
   for (const skeleton::Joint& j : model.joints) {

@@ -169,9 +169,10 @@ void Controller::build(const VectorX& q0) {
 
   // buffers
   for (VectorX* v : {&qdot_, &qdot_prev_, &qdot_free_, &dq_int_, &gamma0_, &gamma_task_, &gamma_level_, &gamma_int_,
-                     &gamma_g_, &gamma_c_, &gamma_, &tmp_})
+                     &gamma_g_, &gamma_c_, &gamma_, &tmp_, &k_j_, &b_j_, &dq_j_, &gamma_j_})
     v->setZero(nv_);
   q_next_.setZero(model_.nq);
+  q_j_.setZero(model_.nq);
   J_.setZero(rows_, nv_);
   JB_.setZero(rows_, nv_);
   b_.setIdentity(nv_, nv_);
@@ -204,6 +205,7 @@ void Controller::reset(const VectorX& q0) {
   q_ = q0;
   qdot_.setZero();
   qdot_prev_.setZero();
+  clearJointCoupling();
   qdot_free_.setZero();
   gamma_c_.setZero();
   frameKinematics();
@@ -294,6 +296,26 @@ VirtualMechanism& Controller::mechanism(int i) {
   checkFrame(i);
   if (!mechanisms_[i]) throw std::invalid_argument(describe(i) + ": no virtual mechanism attached");
   return *mechanisms_[i];
+}
+
+void Controller::setJointCoupling(const VectorX& q_j, const VectorX& stiffness, const VectorX& damping) {
+  if (q_j.size() != model_.nq || stiffness.size() != nv_ || damping.size() != nv_)
+    throw std::invalid_argument("setJointCoupling: sizes " + std::to_string(q_j.size()) + ", " + std::to_string(stiffness.size()) +
+                                ", " + std::to_string(damping.size()) + ", expected " + std::to_string(model_.nq) + ", " +
+                                std::to_string(nv_) + ", " + std::to_string(nv_));
+  if (!q_j.allFinite() || !stiffness.allFinite() || !damping.allFinite())
+    throw std::invalid_argument("setJointCoupling: non-finite values (coupling kept)");
+  if ((stiffness.array() < 0).any() || (damping.array() < 0).any())
+    throw std::invalid_argument("setJointCoupling: negative stiffness or damping (coupling kept)");
+  q_j_ = q_j;
+  k_j_ = stiffness;
+  b_j_ = damping;
+  joint_coupling_ = true;
+}
+
+void Controller::clearJointCoupling() {
+  joint_coupling_ = false;
+  gamma_j_.setZero();
 }
 
 void Controller::setPosture(const VectorX& q_d) {
@@ -448,8 +470,14 @@ StepStatus Controller::computeFreeMotion() {
     gamma_int_.setZero();
   }
 
+  // joint coupling (4.4.2): Γ_j = k_j∘(q_j ⊖ q) − b_j∘q̇_prev, every coordinate
+  if (joint_coupling_) {
+    differenceInPlace(model_, q_, q_j_, dq_j_);
+    gamma_j_ = k_j_.cwiseProduct(dq_j_) - b_j_.cwiseProduct(qdot_prev_);
+  }
+
   // free motion q̇_free = b⁻¹ Γ (2.19–2.20)
-  gamma_ = gamma_task_ + gamma_int_ + gamma_g_;
+  gamma_ = gamma_task_ + gamma_int_ + gamma_g_ + gamma_j_;
   qdot_free_ = gamma_;
   gamma_c_.setZero();
   if (factor_.info() == Eigen::Success) factor_.solveInPlace(qdot_free_);
@@ -507,6 +535,7 @@ void Controller::integrate() {
   have_internal_power_ = config_.internal.enabled;
   port_internal_.add(gamma_int_.dot(qdot_), dt_);
   port_gravity_.add(gamma_g_.dot(qdot_), dt_);
+  port_joint_.add(gamma_j_.dot(qdot_), dt_);
   port_constraint_.add(gamma_c_.dot(qdot_), dt_);
   dissipated_.add(qdot_.cwiseProduct(qdot_).dot(b_a_), dt_);
 

@@ -1,16 +1,20 @@
 #include "mannequin/sim/world.hpp"
 
 #include "mannequin/balance/static_balance.hpp"
+#include "mannequin/balance/variational_balance.hpp"
 #include "mannequin/scenario/engine.hpp"
 
 #include <algorithm>
 #include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <limits>
 #include <cmath>
 #include <set>
 #include <stdexcept>
 
 #include "mannequin/constraints/swing_twist.hpp"
+#include "mannequin/control/first_order.hpp"
 #include "mannequin/math/so3.hpp"
 #include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
@@ -97,6 +101,21 @@ struct World::Physics {
   std::vector<char> stepping;                          // per mannequin: stage 1 succeeded this step
   balance::StaticBalanceSolver margin_solver;          // the force margins (one solver, reused)
   balance::StaticBalanceProblem margin_problem;
+  std::vector<int> body_joint;                         // per body: the joint carrying a segment, −1 if not a segment
+  /// The balance controller of one mannequin (PhysicsConfig::balance_controller).
+  struct BalanceLoop {
+    std::unique_ptr<balance::VariationalBalanceSolver> solver;
+    balance::VariationalBalanceProblem problem;
+    std::vector<int> frames;       // driven frames (indices in Mannequin::frames) it takes over
+    std::vector<char> taken;       // per driven frame: in `frames`
+    skeleton::Data data;           // kinematics at q_b
+    skeleton::VectorX q_b;         // the controller's own configuration: Algorithm 5 iterates on it
+    bool driving = false;          // q_b exists and drives the frames and the posture
+    double fraction = 0.0;         // of the margins asked for, the last solve held
+    skeleton::VectorX k, b;        // joint coupling gains (nv; the root's 0)
+    explicit BalanceLoop(const skeleton::Model& model) : data(model) {}
+  };
+  std::vector<BalanceLoop> balance_loops;              // per mannequin when the controller is on
   explicit Physics(const collision::WorldOptions& o) : cw(o) {}
   /// Whether mannequin m holds object o (contacts between them are ignored).
   bool holds(int m, int o) const {
@@ -129,6 +148,7 @@ struct World::Mannequin {
   std::vector<double> weights;  // current weights (rate-limited)
   bool calibrated = false;
   skeleton::VectorX q_standing;
+  skeleton::VectorX q_posture;  // q_c: the posture target set at calibration
 };
 
 World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : config_(config) {
@@ -245,6 +265,7 @@ void World::buildPhysics() {
   P.body_mannequin.assign(static_cast<std::size_t>(n), -1);
   P.body_object.assign(static_cast<std::size_t>(n), -1);
   P.body_is_foot.assign(static_cast<std::size_t>(n), 0);
+  P.body_joint.assign(static_cast<std::size_t>(n), -1);
   for (int b = 0; b < n; ++b) {
     constraints::BodyBinding& bb = bindings[static_cast<std::size_t>(b)];
     bb.margin = P.cw.margin(b);
@@ -277,6 +298,7 @@ void World::buildPhysics() {
       P.body_mannequin[static_cast<std::size_t>(b)] = static_cast<int>(m);
       const std::string& sn = model.segments[sgi].name;
       P.body_is_foot[static_cast<std::size_t>(b)] = sn.rfind("foot", 0) == 0 || sn.rfind("toes", 0) == 0;
+      P.body_joint[static_cast<std::size_t>(b)] = model.segments[sgi].joint;
     }
   }
   constraints::ContactOptions co = pc.contacts;
@@ -326,6 +348,44 @@ void World::buildPhysics() {
     P.support.back().reserve(static_cast<std::size_t>(pc.balance.max_points));
     if (pc.balance_rows) P.solver->addProducer(P.balance.back().get());
   }
+  // the balance controller (Algorithm 5 in the loop): one solver per mannequin, the frames it takes over
+  const BalanceControllerConfig& bc = pc.balance_controller;
+  if (bc.enabled) {
+    const std::string where = "sim: physics.balance_controller.";
+    if (!(bc.period > 0) || !std::isfinite(bc.period)) throw std::invalid_argument(where + "period must be finite and > 0");
+    if (bc.edges < 3) throw std::invalid_argument(where + "edges must be >= 3");
+    if (!(bc.max_step > 0) || !std::isfinite(bc.max_step)) throw std::invalid_argument(where + "max_step must be finite and > 0");
+    if (!(bc.max_task_step > 0) || !std::isfinite(bc.max_task_step))
+      throw std::invalid_argument(where + "max_task_step must be finite and > 0");
+    if (!(bc.dq_weight > 0) || !std::isfinite(bc.dq_weight)) throw std::invalid_argument(where + "dq_weight must be finite and > 0");
+    if (!(bc.posture_gain >= 0 && bc.posture_gain <= 1)) throw std::invalid_argument(where + "posture_gain must be in [0, 1]");
+    if (!(bc.joint_stiffness >= 0) || !std::isfinite(bc.joint_stiffness) || !(bc.joint_damping >= 0) || !std::isfinite(bc.joint_damping))
+      throw std::invalid_argument(where + "joint_stiffness and joint_damping must be finite and >= 0");
+    for (const math::Vector3& v : bc.force_margins)
+      if (!v.allFinite()) throw std::invalid_argument(where + "force_margins must be finite");
+    for (const auto& mp : mannequins_) {
+      Physics::BalanceLoop L(mp->model);
+      L.solver = std::make_unique<balance::VariationalBalanceSolver>(mp->model);
+      L.taken.assign(mp->frames.size(), 0);
+      L.k = skeleton::VectorX::Constant(mp->model.nv, bc.joint_stiffness);
+      L.b = skeleton::VectorX::Constant(mp->model.nv, bc.joint_damping);
+      L.k.head<6>().setZero();
+      L.b.head<6>().setZero();
+      for (const std::string& f : bc.frames) {
+        std::size_t i = 0;
+        while (i < mp->frames.size() && mp->frames[i].frame != f) ++i;
+        if (i == mp->frames.size()) {
+          std::string driven;
+          for (const DrivenFrame& st : mp->frames) driven += (driven.empty() ? "" : ", ") + st.frame;
+          throw std::invalid_argument(where + "frames: '" + f + "' is not a driven frame of mannequin '" + mp->name +
+                                      "' (driven: " + driven + ")");
+        }
+        L.frames.push_back(static_cast<int>(i));
+        L.taken[i] = 1;
+      }
+      P.balance_loops.push_back(std::move(L));
+    }
+  }
   // the floor plane of the support regions: the floor body's plane (z = 0, +z without one)
   for (const collision::BodySpec& bs : scene.bodies)
     if (bs.name == "floor")
@@ -341,6 +401,12 @@ void World::buildPhysics() {
 
 const collision::CollisionWorld* World::collisionWorld() const { return physics_ ? &physics_->cw : nullptr; }
 const constraints::ConstraintSolver* World::constraintSolver() const { return physics_ ? physics_->solver.get() : nullptr; }
+const skeleton::VectorX* World::balanceConfiguration(int m) const {
+  if (!physics_ || physics_->balance_loops.empty()) return nullptr;
+  const Physics::BalanceLoop& L = physics_->balance_loops.at(static_cast<std::size_t>(m));
+  return L.driving ? &L.q_b : nullptr;
+}
+
 const MannequinDiagnostics& World::mannequinDiagnostics(int m) const {
   return mannequin_diagnostics_.at(static_cast<std::size_t>(m));
 }
@@ -611,6 +677,12 @@ void World::calibrate(Mannequin& m, const mocap::Frame& frame) {
   }
   m.stepper->reset(qc);
   m.stepper->setPosture(qc);
+  m.q_posture = qc;
+  if (physics_ && !physics_->balance_loops.empty()) {
+    std::size_t index = 0;
+    while (mannequins_[index].get() != &m) ++index;
+    physics_->balance_loops[index].driving = false;  // recalibrated: the mocap drives until the next solve
+  }
   std::fill(m.have_previous.begin(), m.have_previous.end(), false);
   const skeleton::Data& d = m.stepper->data();
   for (auto& st : m.frames) {
@@ -835,7 +907,162 @@ bool World::physicsStep() {
     const auto every = static_cast<std::uint64_t>(std::max(1.0, std::round(config_.physics.force_margin_period / dt)));
     if (steps_ % every == 0) updateForceMargins();
   }
+  if (!P.balance_loops.empty()) {
+    const auto every = static_cast<std::uint64_t>(std::max(1.0, std::round(config_.physics.balance_controller.period / dt)));
+    if (steps_ % every == 0) updateBalanceController();
+  }
   return ok;
+}
+
+void World::updateBalanceController() {
+  Physics& P = *physics_;
+  const PhysicsConfig& pc = config_.physics;
+  const BalanceControllerConfig& bc = pc.balance_controller;
+  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+    Mannequin& man = *mannequins_[m];
+    Physics::BalanceLoop& L = P.balance_loops[m];
+    MannequinDiagnostics& md = mannequin_diagnostics_[m];
+    if (!man.calibrated) continue;
+    const skeleton::Data& d = man.stepper->data();  // the simulated mannequin's kinematics at q_{k+1}
+    // Algorithm 5 iterates on the controller's own configuration q_b (from the simulated q at the
+    // start): q_b ← q_b ⊕ δq. Re-starting each solve from the simulated q instead would make the sag
+    // of the couplings under gravity the next solve's starting point, and the body would sink.
+    if (!L.driving) {
+      L.q_b = man.stepper->q();
+      skeleton::forwardKinematics(man.model, L.data, L.q_b);
+      L.fraction = 0.0;
+    }
+    balance::VariationalBalanceProblem& bp = L.problem;
+    // the touching contacts with the static scene, as in the force margins, on the joints of their segments
+    bp.contacts.clear();
+    for (const ContactReport& r : contacts_) {
+      const int ma = P.body_mannequin[static_cast<std::size_t>(r.body_a)], mb = P.body_mannequin[static_cast<std::size_t>(r.body_b)];
+      const bool on_a = ma == static_cast<int>(m), on_b = mb == static_cast<int>(m);
+      if (on_a == on_b) continue;
+      const int other = on_a ? r.body_b : r.body_a;
+      if (P.cw.bodyKind(other) != collision::BodyKind::kStatic) continue;
+      if (!(r.normal_force > 0 || r.distance <= pc.foot_contact_tolerance)) continue;
+      const int joint = P.body_joint[static_cast<std::size_t>(on_a ? r.body_a : r.body_b)];
+      if (joint < 0) continue;
+      balance::BodyContact c;
+      c.joint = joint;
+      c.local_point = d.oMi[static_cast<std::size_t>(joint)].actInv(r.point);
+      c.normal = on_b ? r.normal : math::Vector3(-r.normal);
+      c.mu = P.contacts->friction(r.body_a, r.body_b);
+      // desired force (3.69): what the contact carries now (the LCP's normal force). With 0 the criterion
+      // would spread the weight evenly over the points and pull the CoM to their centroid, and a hand
+      // on the wall would be asked to let go.
+      c.desired_force = r.normal_force * c.normal;
+      bp.contacts.push_back(c);
+    }
+    // each body in contact held (Alg. 5's first loop) where the simulation has it: the controller's body is
+    // brought there by log(H_d H⁻¹), at most max_task_step (m) and max_step (rad) per solve, so that the
+    // equality rows stay within the step's bounds (the controller follows the contacts as simulated)
+    bp.held = balance::holdCurrentPoses(bp.contacts, L.data.oMi);
+    for (balance::HeldBody& h : bp.held) {
+      const math::SE3& sim = d.oMi[static_cast<std::size_t>(h.joint)];
+      math::Vector3 dp = sim.p - h.desired.p;
+      if (dp.norm() > bc.max_task_step) dp *= bc.max_task_step / dp.norm();
+      math::Vector3 dr = math::logSO3(sim.R * h.desired.R.transpose());
+      if (dr.norm() > bc.max_step) dr *= bc.max_step / dr.norm();
+      h.desired = math::SE3(math::expSO3(dr) * h.desired.R, h.desired.p + dp);
+    }
+    // the other driven frames reach for their mocap targets (3.106), unless their body is held
+    bp.tasks.clear();
+    for (std::size_t i = 0; i < man.frames.size(); ++i) {
+      if (L.taken[i] || man.weights[i] <= 0) continue;
+      const int fi = man.frames[i].frame_index;
+      const int joint = man.model.frames[static_cast<std::size_t>(fi)].joint;
+      bool held = false;
+      for (const balance::HeldBody& h : bp.held) held = held || h.joint == joint;
+      if (!held) bp.tasks.push_back({fi, man.frames[i].target.p});
+    }
+    bp.gravity = pc.gravity;
+    bp.edges = bc.edges;
+    bp.max_step = bc.max_step;
+    bp.max_task_step = bc.max_task_step;
+    bp.dq_weight = bc.dq_weight;
+    bp.com_margins.clear();
+    bp.margins_at_com = true;  // each push held at the posture's own CoM (what forceMargin measures)
+    // the internal control (4.1): back towards the calibrated posture where nothing else decides
+    control::differenceInPlace(man.model, L.q_b, man.q_posture, bp.dq_desired);
+    bp.dq_desired *= bc.posture_gain;
+    md.balance_contacts = static_cast<int>(bp.contacts.size());
+    if (bp.contacts.empty()) {
+      // nothing holds it (a jump): no static equilibrium; the mocap and q_c take back over
+      md.balance_status = balance::BalanceStatus::kInfeasible;
+      md.balance_margin_fraction = 0.0;
+      ++md.balance_failures;
+      if (L.driving) {
+        man.stepper->setPosture(man.q_posture);
+        static_cast<ControllerStepper&>(*man.stepper).controller().clearJointCoupling();
+      }
+      L.driving = false;
+      md.balance_driving = false;
+      continue;
+    }
+    // the margins as a continuation: a posture far from holding the pushes asked for cannot get there in
+    // one small step (|δq| ≤ max_step), so each solve asks for a fraction s of them — 5 % more than
+    // the last solve held, else what it held, 20 % less, none — and the fraction grows to 1 as the body
+    // moves (MannequinDiagnostics::balance_margin_fraction). Infeasible even with none: reported as such.
+    const math::Vector3 com_b = skeleton::centerOfMass(man.model, L.data);  // the controller's CoM, at q_b
+    const double last = L.fraction;
+    double tries[4] = {std::min(1.0, last + 0.05), last, std::max(0.0, last - 0.2), 0.0};
+    const int ntries = bc.force_margins.empty() ? 1 : 4;
+    const balance::VariationalBalanceResult* result = nullptr;
+    md.balance_tasks_dropped = false;
+    for (int t = 0; t < ntries; ++t) {
+      if (t > 0 && tries[t] >= tries[t - 1]) continue;  // the same fraction again
+      bp.force_margins.clear();
+      for (const math::Vector3& F : bc.force_margins) {
+        // a push s F at the CoM: the wrench (moment about the world origin, force) = (x_com × sF, sF)
+        const math::Vector3 sF = tries[t] * F;
+        math::Vector6 w;
+        w << com_b.cross(sF), sF;
+        bp.force_margins.push_back(w);
+      }
+      result = &L.solver->solve(bp, L.q_b);
+      ++md.balance_solves;
+      if (result->status == balance::BalanceStatus::kDegenerate && !bp.tasks.empty()) {
+        // the tasks repeat held rows (a hand whose forearm leans on the wall): the contacts come first
+        bp.tasks.clear();
+        md.balance_tasks_dropped = true;
+        result = &L.solver->solve(bp, L.q_b);
+        ++md.balance_solves;
+      }
+      if (result->status == balance::BalanceStatus::kSolved) {
+        L.fraction = bc.force_margins.empty() ? 1.0 : tries[t];
+        break;
+      }
+    }
+    const balance::VariationalBalanceResult& res = *result;
+    md.balance_status = res.status;
+    md.balance_margin_fraction = res.status == balance::BalanceStatus::kSolved ? L.fraction : 0.0;
+    if (res.status == balance::BalanceStatus::kSolved) {
+      L.q_b = skeleton::integrate(man.model, L.q_b, res.dq);
+      skeleton::forwardKinematics(man.model, L.data, L.q_b);
+      md.balance_com = res.com;
+      L.driving = true;
+      man.stepper->setPosture(L.q_b);
+      static_cast<ControllerStepper&>(*man.stepper).controller().setJointCoupling(L.q_b, L.k, L.b);
+    } else {
+      ++md.balance_failures;
+      // no equilibrium with these contacts even without margins: q_b holds (the last posture in equilibrium)
+    }
+    md.balance_driving = L.driving;
+  }
+}
+
+void World::applyBalanceTargets(std::size_t m) {
+  // the frames the balance controller took over: their poses at q_b, held (V_d = 0)
+  const Physics::BalanceLoop& L = physics_->balance_loops[m];
+  if (!L.driving) return;
+  Mannequin& man = *mannequins_[m];
+  for (const int i : L.frames) {
+    DrivenFrame& st = man.frames[static_cast<std::size_t>(i)];
+    st.target = L.data.oMf[static_cast<std::size_t>(st.frame_index)];
+    man.stepper->setTarget(i, st.target, math::Vector6::Zero(), man.weights[static_cast<std::size_t>(i)]);
+  }
 }
 
 void World::updateForceMargins() {
@@ -903,6 +1130,8 @@ bool World::step() {
   const double dt = config_.step;
   bool ok = true;
   for (auto& mp : mannequins_) driveTargets(*mp, dt);
+  if (physics_ && !physics_->balance_loops.empty())
+    for (std::size_t m = 0; m < mannequins_.size(); ++m) applyBalanceTargets(m);
   if (scenario_) stepScenario();
   if (physics_) {
     ok = physicsStep();

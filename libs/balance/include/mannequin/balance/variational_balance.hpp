@@ -15,7 +15,8 @@
 /// the frame's target, at most `max_task_step` long. Bounds (3.104–3.105): |δq_j| ≤ max_step (small
 /// displacements) and, for revolute coordinates, lower − q ≤ δq ≤ upper − q (ball joints' swing/twist
 /// limits are not linear in δq and are left to the simulation's limit rows). Criterion (3.107):
-/// ½(‖f − f_d‖²_{w_f} + α‖(I − NNᵀ)Af‖² + ‖δq‖²_{w_q}), solved as the LCP (3.70) over the edge forces and
+/// ½(‖f − f_d‖²_{w_f} + α‖(I − NNᵀ)Af‖² + ‖δq − δq_d‖²_{w_q}) (δq_d = 0 in 3.107; the internal control of
+/// the thesis's 4.1 otherwise), solved as the LCP (3.70) over the edge forces and
 /// the bounds (BalanceQp). The margins' bias is removed from f as in (3.92).
 ///
 /// Contact points and targets are world positions; contacts are given on a joint of the model (the
@@ -68,6 +69,15 @@ struct VariationalBalanceProblem {
   double max_task_step = 0.01;  ///< m, the most a task moves its frame in one step
   std::vector<math::Vector3> com_margins;
   std::vector<math::Vector6> force_margins;
+  /// The margins' edge reserves from G_f⁺ (the CoM given, as forceMargin) rather than from the whole G⁺
+  /// (3.95, the CoM free): then each push D is balanced by non-negative edge forces at the step's own
+  /// linearised CoM, where with the thesis's form part of D's moment is taken by a CoM shift
+  /// (G⁺)_x D the posture does not make. The sim's balance controller sets it.
+  bool margins_at_com = false;
+  /// The internal control of the thesis's (4.1) (4.4.1): the criterion's ‖δq‖²_{w_q} becomes
+  /// ‖δq − δq_d‖²_{w_q}, δq_d = β (q_d ⊖ q) pulling the posture towards q_d where the equilibrium, the
+  /// held bodies and the tasks leave it free. Empty: 0, as (3.107). nv entries (velocity coordinates).
+  skeleton::VectorX dq_desired;
 };
 
 /// The held poses of every joint carrying a contact, at the configuration of `data` (forward kinematics done).

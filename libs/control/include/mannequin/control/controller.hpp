@@ -93,7 +93,8 @@ class Controller {
   Controller(const skeleton::Model& model, const ControllerConfig& config, const VectorX& q0);
 
   //---- state ----
-  /// q = q0, q̇ = 0, targets at the current poses, energies and observer reset, mechanisms re-attached.
+  /// q = q0, q̇ = 0, targets at the current poses, energies and observer reset, mechanisms re-attached,
+  /// joint coupling cleared.
   void reset(const VectorX& q0);
   const VectorX& q() const { return q_; }          ///< (nq) configuration
   const VectorX& qdot() const { return qdot_; }    ///< (nv) velocity of the last step
@@ -134,6 +135,17 @@ class Controller {
   /// α of the internal potential (energy observer).
   double alpha() const { return observer_.alpha(); }
   const EnergyObserver& energyObserver() const { return observer_; }
+
+  //---- joint coupling (thesis 4.4.2: a joint controller that produces a configuration change δq) ----
+  /// Γ_j = k_j∘(q_j ⊖ q) − b_j∘q̇_prev on every coordinate, NOT projected and without the observer's α:
+  /// a spring-damper per coordinate towards q_j, added to Γ at each step until clearJointCoupling().
+  /// The balance controller in the loop (sim::World) drives the mannequin to its q ⊕ δq with it.
+  /// \throws std::invalid_argument on sizes (nq, nv, nv), non-finite values or negative gains; state kept.
+  void setJointCoupling(const VectorX& q_j, const VectorX& stiffness, const VectorX& damping);
+  void clearJointCoupling();
+  bool jointCoupling() const { return joint_coupling_; }
+  const VectorX& jointCouplingTorque() const { return gamma_j_; }  ///< Γ_j of the last stage 1 (nv)
+  const PortEnergy& jointCouplingPort() const { return port_joint_; }
 
   //---- the step ----
   StepStatus step();                       ///< computeFreeMotion() then integrate()
@@ -216,7 +228,9 @@ class Controller {
   EnergyObserver observer_;
   double potential_ = 0.0;
   bool have_internal_power_ = false;
-  PortEnergy port_internal_, port_gravity_, port_constraint_, dissipated_;
+  PortEnergy port_internal_, port_gravity_, port_constraint_, dissipated_, port_joint_;
+  bool joint_coupling_ = false;
+  VectorX q_j_, k_j_, b_j_, dq_j_, gamma_j_;  // joint coupling (nq, nv, nv, nv, nv)
   double time_ = 0.0;
   long non_finite_steps_ = 0;
   bool free_motion_ready_ = false;

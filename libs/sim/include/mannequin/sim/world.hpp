@@ -31,6 +31,7 @@
 #include <string>
 #include <vector>
 
+#include "mannequin/balance/static_balance.hpp"
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/collision/world.hpp"
 #include "mannequin/constraints/balance.hpp"
@@ -71,6 +72,41 @@ struct MannequinSetup {
   std::optional<control::ControllerConfig> controller;
 };
 
+/// The multi-contact balance controller in the loop (thesis 3.96–3.107, Algorithm 5, and 4.4.2).
+/// Every `period` s, for each calibrated mannequin: Algorithm 5 at q_k with its touching contacts with
+/// the static scene (the points, normals and μ of the step's contact rows; each body in contact held
+/// where it is), the driven frames that are neither in contact nor in `frames` as position tasks towards
+/// their mocap targets, and the margins below. Its result q_b = q_k ⊕ δq drives the mannequin through
+/// couplings, so the loop stays force-based and passive (4.4.2: "a joint controller that generates the
+/// torques giving δq"): the targets of the control frames named in `frames` (the pelvis and head of
+/// the VR-room set) become their poses at q_b instead of their mocap bodies', every other coordinate is
+/// pulled towards q_b by a joint spring-damper (the joint controller 4.4.2 proposes), and q_b is the
+/// posture target of the internal control (2.25). The spring-dampers of those couplings carry the body there
+/// against gravity; contacts, limits and the other frames act as before. A solve that fails (no
+/// equilibrium with these margins: kInfeasible) hands the frames back to their mocap bodies and the
+/// posture back to q_c until a later solve succeeds; MannequinDiagnostics says which.
+/// Allocates at each solve (like the force margins): off by default.
+struct BalanceControllerConfig {
+  bool enabled = false;
+  double period = 0.01;                     ///< s between solves (rounded to steps, ≥ 1 step)
+  std::vector<std::string> frames = {"pelvis", "head"};  ///< driven frames the controller takes over
+  /// Pushes (N, world) at the CoM the posture must hold (3.93–3.95), each balanced by non-negative
+  /// contact forces at the posture's own CoM (VariationalBalanceProblem::margins_at_com).
+  std::vector<math::Vector3> force_margins;
+  int edges = 4;                            ///< edges per linearised friction cone (3.56)
+  double max_step = 0.02;                   ///< |δq_j| per solve (rad, m): the small-displacement bound
+  double max_task_step = 0.01;              ///< m per solve a task moves its frame
+  double dq_weight = 1e6;                   ///< w_q of (3.107): 1 mrad of δq weighs as 1 N of edge force
+  /// β of the internal control (thesis 4.1): each solve pulls δq towards β (q_c ⊖ q_k), q_c the calibrated
+  /// posture, where the equilibrium, held bodies and tasks leave it free. Without it (0) nothing holds
+  /// the posture between solves: each starts from where gravity left the body, and it sinks.
+  double posture_gain = 0.2;
+  /// The joint coupling towards q_b (control::Controller::setJointCoupling) on every coordinate but the
+  /// root's (the frames in `frames` place the root): N·m/rad and N·m·s/rad.
+  double joint_stiffness = 1000.0;
+  double joint_damping = 0.0;
+};
+
 /// Physics in the loop (thesis Alg. 4): contacts between the mannequins, the scene and the objects as
 /// rows of one LCP per step with the joint limits (and balance, grasps). Needs ControllerSteppers.
 struct PhysicsConfig {
@@ -105,6 +141,8 @@ struct PhysicsConfig {
   /// bisection to 1 N, at most `force_margin_max` N).
   double force_margin_period = 0.0;
   double force_margin_max = 1000.0;
+  /// The multi-contact balance controller (libs/balance, Algorithm 5) in the loop.
+  BalanceControllerConfig balance_controller;
   /// τ of the scene's objects without a `time_constant` (s; sim::RigidObject).
   double object_time_constant = 0.05;
   constraints::SolverOptions solver;
@@ -154,6 +192,19 @@ struct MannequinDiagnostics {
   /// between evaluations.
   double force_margin_n = std::numeric_limits<double>::quiet_NaN();
   int force_margin_contacts = 0;    ///< touching contact points the last evaluation used
+  /// The balance controller (PhysicsConfig::balance_controller): the outcome of its last solve
+  /// (kInvalid before the first), whether its result drives the mannequin now, its solves and failures.
+  balance::BalanceStatus balance_status = balance::BalanceStatus::kInvalid;
+  bool balance_driving = false;
+  int balance_contacts = 0;         ///< contact points of the last solve
+  /// Of the force margins asked for, the fraction the last solve held (1: all; the controller grows it
+  /// step by step, BalanceControllerConfig); 0 after a failure.
+  double balance_margin_fraction = 0.0;
+  /// The last solve left the tasks out: with them its equality rows were dependent (a hand task whose
+  /// forearm is held on a wall).
+  bool balance_tasks_dropped = false;
+  math::Vector3 balance_com = math::Vector3::Zero();  ///< the controller's CoM (world, m): at q_b, linearised
+  long balance_solves = 0, balance_failures = 0;  ///< solves (every margin fraction tried), failed updates
 };
 
 /// What the last step did (thesis Alg. 4 stages), for callers and sim.world.
@@ -226,6 +277,9 @@ class World {
   const collision::CollisionWorld* collisionWorld() const;
   const StepDiagnostics& diagnostics() const { return diagnostics_; }
   const MannequinDiagnostics& mannequinDiagnostics(int m) const;
+  /// The balance controller's configuration q_b of mannequin m (PhysicsConfig::balance_controller),
+  /// nullptr while it does not drive the mannequin.
+  const skeleton::VectorX* balanceConfiguration(int m) const;
   /// Contacts of the last step (empty when physics is off).
   const std::vector<ContactReport>& contacts() const { return contacts_; }
   /// The constraint solver (nullptr when physics is off).
@@ -277,6 +331,8 @@ class World {
   const Source* findSource(const std::string& name) const;
   void calibrate(Mannequin& m, const mocap::Frame& frame);
   void updateForceMargins();
+  void updateBalanceController();
+  void applyBalanceTargets(std::size_t m);
   void updateSupport();
   void fillDiagnostics();
   void buildPhysics();
