@@ -6,66 +6,27 @@
 // capture (two columns, one MCAP per mannequin); bad inputs: exit 2, the file named, no report left.
 #include <gtest/gtest.h>
 #include <mannequin/v1/world.pb.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <array>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
+#include <tuple>
 #include <utility>
 
+#include "../common/tool_run.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-fs::path toolPath() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "mannequin-batch"; }
+using mannequin::testutil::ToolResult;
 
-fs::path temp(const std::string& name) {
-  return fs::temp_directory_path() / ("batch_tool_test_" + std::to_string(::getpid()) + "_" + name);
-}
+fs::path toolPath() { return mannequin::testutil::binDir() / "mannequin-batch"; }
 
-struct ToolRun {
-  int status = -1;
-  std::string out, err;
-};
-
-// Runs the tool under timeout(1) (a hung run fails at the deadline); stdout captured, stderr to a file.
-ToolRun run(const std::string& args, int timeout_s = 300) {
-  ToolRun r;
-  const fs::path err = temp("stderr");
-  const std::string cmd = "timeout " + std::to_string(timeout_s) + " " + toolPath().string() + " " + args + " 2>" + err.string();
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf{};
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  std::ifstream in(err);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  fs::remove(err);
-  return r;
-}
-
-// Runs python3 `script` with sys.argv[1:] = args; its stdout+stderr and exit status.
-std::pair<int, std::string> python(const std::string& script, const std::string& args) {
-  const fs::path py = temp("check.py"), out = temp("check.txt");
-  std::ofstream(py) << script << "\n";
-  const int st = std::system(("timeout 60 python3 " + py.string() + " " + args + " >" + out.string() + " 2>&1").c_str());
-  std::ifstream o(out);
-  std::stringstream text;
-  text << o.rdbuf();
-  fs::remove(py);
-  fs::remove(out);
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, text.str()};
+// Runs the tool under timeout(1) (a hung run fails at the deadline).
+ToolResult run(const std::string& args, int timeout_s = 300) {
+  return mannequin::testutil::runTool(toolPath().string() + " " + args, timeout_s);
 }
 
 // summary.json: the documented keys and values that make sense, for `runs` runs of `seconds` s at 60 Hz
@@ -166,21 +127,31 @@ void expectNoReport(const fs::path& dir) {
   EXPECT_FALSE(fs::exists(dir / ".partial"));
 }
 
+// Each test's files (temp(name)) in a directory of its own, removed after it.
+class BatchTool : public mannequin::testutil::TempDirTest {
+ protected:
+  // Runs python3 `script` with sys.argv[1:] = args; its exit status and stdout+stderr.
+  std::pair<int, std::string> python(const std::string& script, const std::string& args) const {
+    const ToolResult r = mannequin::testutil::runPython(dir_, script, args);
+    return {r.exit_code, r.out};
+  }
+};
+
 }  // namespace
 
-TEST(BatchTool, HelpExitsZero) {
+TEST_F(BatchTool, HelpExitsZero) {
   ASSERT_TRUE(fs::exists(toolPath())) << toolPath();
-  const ToolRun r = run("--help");
-  EXPECT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("--help");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("--compare"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("--mocap"), std::string::npos) << r.out;
 }
 
-TEST(BatchTool, DemoCaptureWritesMcapSummaryAndReportDeterministically) {
+TEST_F(BatchTool, DemoCaptureWritesMcapSummaryAndReportDeterministically) {
   const fs::path dir = temp("demo"), again = temp("demo_again");
   const std::string args = kDemo + " --mannequin configs/mannequins/male_50th.yaml --duration 3 --out ";
-  const ToolRun a = run(args + dir.string());
-  ASSERT_EQ(a.status, 0) << a.err;
+  const ToolResult a = run(args + dir.string());
+  ASSERT_EQ(a.exit_code, 0) << a.err;
   ASSERT_TRUE(fs::exists(dir / "summary.json"));
   ASSERT_TRUE(fs::exists(dir / "report.html"));
   ASSERT_TRUE(fs::exists(dir / "run.mcap"));
@@ -202,20 +173,20 @@ TEST(BatchTool, DemoCaptureWritesMcapSummaryAndReportDeterministically) {
   ASSERT_TRUE(w.ParseFromString(messages.back().data));
   ASSERT_EQ(w.mannequins_size(), 1);
 
-  const ToolRun b = run(args + again.string());
-  ASSERT_EQ(b.status, 0) << b.err;
+  const ToolResult b = run(args + again.string());
+  ASSERT_EQ(b.exit_code, 0) << b.err;
   std::tie(s, out) = python(kNoWallClock, (dir / "summary.json").string() + " " + (again / "summary.json").string());
   EXPECT_EQ(s, 0) << out;
   fs::remove_all(dir);
   fs::remove_all(again);
 }
 
-TEST(BatchTool, CompareOnTheC3dCaptureGivesTwoColumns) {
+TEST_F(BatchTool, CompareOnTheC3dCaptureGivesTwoColumns) {
   // the c3d.org lab walk through `source: c3d` (configs/mappings/c3d_sample01.yaml: pelvis and feet)
   const fs::path dir = temp("compare");
-  const ToolRun r = run("--mocap data/c3d/sample01_Eb015pr.c3d --mannequin configs/mannequins/male_50th.yaml "
+  const ToolResult r = run("--mocap data/c3d/sample01_Eb015pr.c3d --mannequin configs/mannequins/male_50th.yaml "
                         "--compare configs/mannequins/female_05th.yaml --duration 2 --out " + dir.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_TRUE(fs::exists(dir / "male_50th" / "run.mcap"));
   EXPECT_TRUE(fs::exists(dir / "female_05th" / "run.mcap"));
   EXPECT_FALSE(fs::exists(dir / "run.mcap"));
@@ -228,13 +199,13 @@ TEST(BatchTool, CompareOnTheC3dCaptureGivesTwoColumns) {
   fs::remove_all(dir);
 }
 
-TEST(BatchTool, BadInputsNameTheFileExitTwoAndLeaveNoReport) {
+TEST_F(BatchTool, BadInputsNameTheFileExitTwoAndLeaveNoReport) {
   const fs::path dir = temp("bad");
   const std::string m = " --mannequin configs/mannequins/male_50th.yaml --duration 1 --out " + dir.string();
   // an unreadable capture
   const fs::path missing = temp("missing.c3d");
-  ToolRun r = run("--mocap " + missing.string() + m);
-  EXPECT_EQ(r.status, 2) << r.err;
+  ToolResult r = run("--mocap " + missing.string() + m);
+  EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(missing.string()), std::string::npos) << r.err;
   expectNoReport(dir);
 
@@ -247,7 +218,7 @@ TEST(BatchTool, BadInputsNameTheFileExitTwoAndLeaveNoReport) {
     std::ofstream(truncated, std::ios::binary) << bytes;
   }
   r = run("--mocap " + truncated.string() + m);
-  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(truncated.string()), std::string::npos) << r.err;
   expectNoReport(dir);
 
@@ -266,7 +237,7 @@ TEST(BatchTool, BadInputsNameTheFileExitTwoAndLeaveNoReport) {
     }
   }
   r = run("--mocap " + nan.string() + " --config configs/sim/sim_demo.yaml" + m);
-  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(nan.string() + ":"), std::string::npos) << r.err;
   expectNoReport(dir);
 
@@ -274,18 +245,18 @@ TEST(BatchTool, BadInputsNameTheFileExitTwoAndLeaveNoReport) {
   const fs::path mannequin = temp("bad_mannequin.yaml");
   std::ofstream(mannequin) << "name: m\nstature_m: 1.75\nmass_kgg: 70\n";
   r = run(kDemo + " --mannequin configs/mannequins/male_50th.yaml --compare " + mannequin.string() + " --out " + dir.string());
-  EXPECT_EQ(r.status, 2) << r.err;
+  EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(mannequin.string() + ":3"), std::string::npos) << r.err;
   expectNoReport(dir);
   // nothing of the good mannequin's run either (every input is read before the first run)
   EXPECT_FALSE(fs::exists(dir / "male_50th"));
 
   // a complete earlier report in DIR is not left looking like this run's
-  const ToolRun good = run(kDemo + m);
-  ASSERT_EQ(good.status, 0) << good.err;
+  const ToolResult good = run(kDemo + m);
+  ASSERT_EQ(good.exit_code, 0) << good.err;
   ASSERT_TRUE(fs::exists(dir / "summary.json"));
   r = run("--mocap " + missing.string() + m);
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   expectNoReport(dir);
   for (const fs::path& p : {truncated, nan, mannequin}) fs::remove(p);
   fs::remove_all(dir);

@@ -1,61 +1,34 @@
 // mannequin-bvh run as a separate process: exact --json outputs and exit codes.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
 
-#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
+
+#include "../common/tool_run.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-struct ToolRun {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
+using mannequin::testutil::ToolResult;
 
-// the tool lands in build/bin, the test binary in build/bin/tests
-fs::path toolPath() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "mannequin-bvh"; }
+fs::path toolPath() { return mannequin::testutil::binDir() / "mannequin-bvh"; }
 
 std::string dataPath(const std::string& name) {
   const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
   return std::string(root ? root : ".") + "/data/bvh/" + name;
 }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class ToolTest : public ::testing::Test {
+class ToolTest : public mannequin::testutil::TempDirTest {
  protected:
   void SetUp() override {
     ASSERT_TRUE(fs::exists(toolPath())) << toolPath();
-    dir_ = fs::temp_directory_path() / ("bvh_tool_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
-  // runs the tool with `args` (already shell-quoted where needed)
-  ToolRun run(const std::string& args) {
-    const fs::path out = dir_ / "out";
-    const fs::path err = dir_ / "err";
-    const std::string cmd = toolPath().string() + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int raw = std::system(cmd.c_str());
-    ToolRun r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-  }
+  // runs the tool with `args` (already shell-quoted where needed) under a 60 s deadline
+  ToolResult run(const std::string& args) { return mannequin::testutil::runTool(toolPath().string() + " " + args, 60); }
 
   std::string write(const std::string& name, const std::string& text) {
     const fs::path p = dir_ / name;
@@ -63,7 +36,6 @@ class ToolTest : public ::testing::Test {
     return p.string();
   }
 
-  fs::path dir_;
 };
 
 const char* kTiny =
@@ -75,41 +47,41 @@ const char* kTiny =
 }  // namespace
 
 TEST_F(ToolTest, InfoJsonOnRealCaptures) {
-  ToolRun r = run("info " + dataPath("cmu_max_131_03.bvh") + " --json");
-  EXPECT_EQ(r.status, 0) << r.err;
+  ToolResult r = run("info " + dataPath("cmu_max_131_03.bvh") + " --json");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, "{\"joints\": 31, \"channels\": 96, \"frames\": 1102, \"frame_time\": 0.0083333, \"root\": \"Hips\"}\n");
   r = run("info --json " + dataPath("mocapbank_test.bvh"));
-  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, "{\"joints\": 19, \"channels\": 60, \"frames\": 455, \"frame_time\": 0.033333, \"root\": \"Hips\"}\n");
 }
 
 TEST_F(ToolTest, InfoHumanReadable) {
-  const ToolRun r = run("info " + write("tiny.bvh", kTiny));
-  EXPECT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("info " + write("tiny.bvh", kTiny));
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("joints:     2 (+ 1 End Sites)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("b:B  offset (0, 1, 0)  [Xrotation Yrotation Zrotation]"), std::string::npos) << r.out;
 }
 
 TEST_F(ToolTest, PosesJsonExact) {
   // hand-computed: frame 0 turns the root 90° about z, frame 1 the child 90° about x; End Sites omitted
-  const ToolRun r = run("poses " + write("tiny.bvh", kTiny) + " --frames 0,-1 --json");
-  EXPECT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("poses " + write("tiny.bvh", kTiny) + " --frames 0,-1 --json");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out,
             "{\"0\": {\"A\": {\"p\": [11, 2, 3], \"R\": [[0, -1, 0], [1, 0, 0], [0, 0, 1]]}, "
             "\"b:B\": {\"p\": [10, 2, 3], \"R\": [[0, -1, 0], [1, 0, 0], [0, 0, 1]]}}, "
             "\"1\": {\"A\": {\"p\": [1, 2, 3], \"R\": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}, "
             "\"b:B\": {\"p\": [1, 3, 3], \"R\": [[1, 0, 0], [0, 0, -1], [0, 1, 0]]}}}\n");
   // a lone negative frame, repeated frames printed once under the resolved key
-  const ToolRun last = run("poses " + write("tiny2.bvh", kTiny) + " --frames -1 --json");
-  const ToolRun again = run("poses " + write("tiny3.bvh", kTiny) + " --frames=1,-1 --json");
-  EXPECT_EQ(last.status, 0) << last.err;
+  const ToolResult last = run("poses " + write("tiny2.bvh", kTiny) + " --frames -1 --json");
+  const ToolResult again = run("poses " + write("tiny3.bvh", kTiny) + " --frames=1,-1 --json");
+  EXPECT_EQ(last.exit_code, 0) << last.err;
   EXPECT_EQ(last.out.rfind("{\"1\": {\"A\": {\"p\": [1, 2, 3]", 0), 0u) << last.out;
   EXPECT_EQ(last.out, again.out);
 }
 
 TEST_F(ToolTest, PosesJsonOnRealCapture) {
-  const ToolRun r = run("poses " + dataPath("cmu_max_131_03.bvh") + " --frames 0,100,-1 --json");
-  EXPECT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("poses " + dataPath("cmu_max_131_03.bvh") + " --frames 0,100,-1 --json");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   // the root is at offset (0,0,0) + the position channels of frame 0 (5.1723 16.9371 -29.1264)
   EXPECT_EQ(r.out.rfind("{\"0\": {\"Hips\": {\"p\": [5.1723, 16.9371, -29.1264], \"R\": [[", 0), 0u) << r.out.substr(0, 200);
   EXPECT_NE(r.out.find("}, \"100\": {\"Hips\": "), std::string::npos);
@@ -137,13 +109,13 @@ TEST_F(ToolTest, BadCommandLinesExitTwo) {
       {"info " + tiny + " --bogus", "--bogus"},
   };
   for (const auto& c : cases) {
-    const ToolRun r = run(c.args);
-    EXPECT_EQ(r.status, 2) << c.args;
+    const ToolResult r = run(c.args);
+    EXPECT_EQ(r.exit_code, 2) << c.args;
     EXPECT_TRUE(r.out.empty()) << c.args;
     EXPECT_NE(r.err.find(c.message), std::string::npos) << c.args << " -> " << r.err;
   }
-  const ToolRun help = run("--help");
-  EXPECT_EQ(help.status, 0);
+  const ToolResult help = run("--help");
+  EXPECT_EQ(help.exit_code, 0);
   EXPECT_NE(help.out.find("RESOLVED non-negative index"), std::string::npos);
 }
 
@@ -151,11 +123,11 @@ TEST_F(ToolTest, MalformedFileExitsOneWithFileAndLine) {
   std::string broken = kTiny;
   broken.replace(broken.find("0 0 0 0 0 0 90 0 0"), 18, "0 0 0 0 0 0 90 0");
   const std::string path = write("broken.bvh", broken);
-  const ToolRun r = run("info " + path + " --json");
-  EXPECT_EQ(r.status, 1);
+  const ToolResult r = run("info " + path + " --json");
+  EXPECT_EQ(r.exit_code, 1);
   EXPECT_TRUE(r.out.empty());
   EXPECT_EQ(r.err, "mannequin-bvh: " + path + ":20: expected 9 channel values in frame 1, got 8\n");
-  const ToolRun missing = run("info " + (dir_ / "none.bvh").string());
-  EXPECT_EQ(missing.status, 1);
+  const ToolResult missing = run("info " + (dir_ / "none.bvh").string());
+  EXPECT_EQ(missing.exit_code, 1);
   EXPECT_NE(missing.err.find("none.bvh: cannot open file"), std::string::npos);
 }

@@ -1,71 +1,41 @@
 // mannequin-c3d run as a separate process: its JSON parsed by python3's json module, exit codes,
 // one-line errors naming the file.
 #include <gtest/gtest.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <cstdlib>
+#include <algorithm>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
+#include "../common/tool_run.hpp"
 #include "samples.hpp"
 namespace fs = std::filesystem;
 
 namespace {
 using c3dtest::samplePath;
 
-struct ToolRun {
-  int status = -1;
-  std::string out;
-  std::string err;
-};
+using mannequin::testutil::slurp;
+using mannequin::testutil::ToolResult;
 
-fs::path toolPath() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "mannequin-c3d"; }
+fs::path toolPath() { return mannequin::testutil::binDir() / "mannequin-c3d"; }
 
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
-
-class C3dTool : public ::testing::Test {
+class C3dTool : public mannequin::testutil::TempDirTest {
  protected:
   void SetUp() override {
     ASSERT_TRUE(fs::exists(toolPath())) << toolPath();
     ASSERT_TRUE(fs::exists(samplePath("pr"))) << samplePath("pr");
-    dir_ = fs::temp_directory_path() / ("c3d_tool_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_);
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
-  ToolRun run(const std::string& args) {
-    const fs::path out = dir_ / "out";
-    const fs::path err = dir_ / "err";
-    // a deadline: a hung tool fails the test (status 124 from timeout) instead of hanging ctest
-    const std::string cmd = "timeout 60 " + toolPath().string() + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int raw = std::system(cmd.c_str());
-    ToolRun r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
   }
 
-  // runs python3 `script` with json.load(sys.stdin) as `d` on `json`; returns its stdout
+  // a deadline: a hung tool fails the test (exit 124 from timeout) instead of hanging ctest
+  ToolResult run(const std::string& args) { return mannequin::testutil::runTool(toolPath().string() + " " + args, 60); }
+
+  // runs python3 `script` with json.load(sys.stdin) as `d` on `json`; returns its stdout (and stderr)
   std::string python(const std::string& json, const std::string& script) {
     const fs::path in = dir_ / "in.json";
-    const fs::path py = dir_ / "check.py";
-    const fs::path out = dir_ / "py.out";
     std::ofstream(in, std::ios::binary) << json;
-    std::ofstream(py) << "import json, sys\nd = json.load(sys.stdin)\n" << script << "\n";
-    const std::string cmd = "timeout 60 python3 " + py.string() + " <" + in.string() + " >" + out.string() + " 2>&1";
-    const int raw = std::system(cmd.c_str());
-    EXPECT_TRUE(WIFEXITED(raw) && WEXITSTATUS(raw) == 0) << slurp(out) << "\non:\n" << json;
-    return slurp(out);
+    const ToolResult r = mannequin::testutil::runPython(dir_, "import json, sys\nd = json.load(sys.stdin)\n" + script, "<" + in.string());
+    EXPECT_EQ(r.exit_code, 0) << r.out << "\non:\n" << json;
+    return r.out;
   }
 
   std::string write(const std::string& name, const std::string& bytes) {
@@ -74,15 +44,14 @@ class C3dTool : public ::testing::Test {
     return p.string();
   }
 
-  fs::path dir_;
 };
 
 int lines(const std::string& s) { return static_cast<int>(std::count(s.begin(), s.end(), '\n')); }
 
 TEST_F(C3dTool, InfoJsonHasTheDocumentedKeys) {
   for (const char* kind : {"pr", "sr", "vr"}) {
-    const ToolRun r = run("info " + samplePath(kind) + " --json");
-    ASSERT_EQ(r.status, 0) << r.err;
+    const ToolResult r = run("info " + samplePath(kind) + " --json");
+    ASSERT_EQ(r.exit_code, 0) << r.err;
     EXPECT_EQ(lines(r.out), 1);
     EXPECT_EQ(python(r.out,
                      "print(d['points'], d['frames'], d['rate'], d['first_frame'], d['analog_per_frame'], "
@@ -95,8 +64,8 @@ TEST_F(C3dTool, InfoJsonHasTheDocumentedKeys) {
 }
 
 TEST_F(C3dTool, PointsJsonAtFramesFromBothEnds) {
-  const ToolRun r = run("points " + samplePath("pr") + " --frames 0,250,-1 --json");
-  ASSERT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("points " + samplePath("pr") + " --frames 0,250,-1 --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(lines(r.out), 1);
   // frame 0 RFT1 as read by hand (see c3d_test.cpp), LFT1 invalid; -1 is frame 449
   EXPECT_EQ(python(r.out,
@@ -104,15 +73,15 @@ TEST_F(C3dTool, PointsJsonAtFramesFromBothEnds) {
                    "d['0']['LFT1'], 'truncated' in d)"),
             "['0', '250', '449'] 26 [248.5833, 226.8333, 37.4167] None False\n");
   // a lone negative frame after a space
-  const ToolRun last = run("points " + samplePath("pr") + " --frames -1 --json");
-  ASSERT_EQ(last.status, 0) << last.err;
+  const ToolResult last = run("points " + samplePath("pr") + " --frames -1 --json");
+  ASSERT_EQ(last.exit_code, 0) << last.err;
   EXPECT_EQ(python(last.out, "print(list(d.keys()), d['449']['RFT1'])"), "['449'] [324.583344, 2248, 33.75]\n");
   // the three formats print the same thing
   EXPECT_EQ(run("points " + samplePath("sr") + " --frames 0,250,-1 --json").out, r.out);
   EXPECT_EQ(run("points " + samplePath("vr") + " --frames 0,250,-1 --json").out, r.out);
   // text form
-  const ToolRun t = run("points " + samplePath("pr") + " --frames 0");
-  EXPECT_EQ(t.status, 0);
+  const ToolResult t = run("points " + samplePath("pr") + " --frames 0");
+  EXPECT_EQ(t.exit_code, 0);
   EXPECT_NE(t.out.find("LFT1             invalid"), std::string::npos) << t.out;
   EXPECT_NE(t.out.find("RFT1             (    248.5833,     226.8333,      37.4167)"), std::string::npos) << t.out;
 }
@@ -120,31 +89,31 @@ TEST_F(C3dTool, PointsJsonAtFramesFromBothEnds) {
 TEST_F(C3dTool, TruncatedFileIsReportedAndReadToItsLastWholeFrame) {
   const std::string bytes = slurp(samplePath("pr"));
   const std::string cut = write("cut.c3d", bytes.substr(0, 10 * 512 + 3 * 672 + 100));
-  const ToolRun i = run("info " + cut + " --json");
-  ASSERT_EQ(i.status, 0) << i.err;
+  const ToolResult i = run("info " + cut + " --json");
+  ASSERT_EQ(i.exit_code, 0) << i.err;
   EXPECT_EQ(python(i.out, "print(d['frames'], d['truncated'], d['frames_present'])"), "450 True 3\n");
-  const ToolRun p = run("points " + cut + " --frames 0,-1 --json");
-  ASSERT_EQ(p.status, 0) << p.err;
+  const ToolResult p = run("points " + cut + " --frames 0,-1 --json");
+  ASSERT_EQ(p.exit_code, 0) << p.err;
   EXPECT_EQ(python(p.out, "print(sorted(k for k in d if k.isdigit()), d['truncated'], d['frames_present'])"),
             "['0', '2'] True 3\n");
   EXPECT_NE(run("info " + cut).out.find("TRUNCATED:  only 3 whole frames present of 450 declared"), std::string::npos);
-  const ToolRun out = run("points " + cut + " --frames 3 --json");
-  EXPECT_EQ(out.status, 2);
+  const ToolResult out = run("points " + cut + " --frames 3 --json");
+  EXPECT_EQ(out.exit_code, 2);
   EXPECT_NE(out.err.find("frame 3 outside the 3 frames present"), std::string::npos) << out.err;
   EXPECT_NE(out.err.find("truncated"), std::string::npos) << out.err;
 }
 
 TEST_F(C3dTool, BadInputExitsTwoWithOneLineNamingTheFile) {
   const std::string missing = (dir_ / "missing.c3d").string();
-  ToolRun r = run("info " + missing + " --json");
-  EXPECT_EQ(r.status, 2);
+  ToolResult r = run("info " + missing + " --json");
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(r.out.empty());
   EXPECT_EQ(r.err, "mannequin-c3d: " + missing + ": byte 0: cannot open: No such file or directory\n");
 
   const std::string bytes = slurp(samplePath("pr"));
   const std::string short_header = write("short.c3d", bytes.substr(0, 100));
   r = run("points " + short_header + " --frames 0 --json");
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(lines(r.err), 1);
   EXPECT_NE(r.err.find(short_header + ": byte 0: the 512-byte header runs past the end of the file"), std::string::npos)
       << r.err;
@@ -153,23 +122,23 @@ TEST_F(C3dTool, BadInputExitsTwoWithOneLineNamingTheFile) {
   bad[515] = 77;
   const std::string bad_proc = write("proc.c3d", bad);
   r = run("info " + bad_proc);
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.err, "mannequin-c3d: " + bad_proc + ": byte 515: unknown processor type 77 (84 Intel, 85 DEC, 86 SGI/MIPS)\n");
 
   r = run("points " + samplePath("pr") + " --frames 0,x --json");
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(r.err, "mannequin-c3d: --frames: expected a comma-separated list of integers, got 'x'\n");
   r = run("points " + samplePath("pr") + " --frames 450 --json");
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_EQ(lines(r.err), 1);
   EXPECT_NE(r.err.find(samplePath("pr") + ": --frames: frame 450 outside the 450 frames present"), std::string::npos)
       << r.err;
   r = run("points " + samplePath("pr") + " --frames -451");
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   r = run("points " + samplePath("pr"));  // --frames missing
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   r = run("--help");
-  EXPECT_EQ(r.status, 0);
+  EXPECT_EQ(r.exit_code, 0);
   EXPECT_NE(r.out.find("info"), std::string::npos);
 }
 

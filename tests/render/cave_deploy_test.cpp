@@ -2,19 +2,16 @@
 // headless walls) started by mannequin-launch: the three walls swap the same sim.world steps.
 #include <gtest/gtest.h>
 
-#include <sys/wait.h>
-#include <unistd.h>
-
 #include <algorithm>
 #include <cstdint>
-#include <cstdlib>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "../common/tool_run.hpp"
 #include "mannequin/core/paths.hpp"
 #include "mannequin/render/view.hpp"
 
@@ -23,19 +20,8 @@ namespace fs = std::filesystem;
 namespace mannequin::render {
 namespace {
 
-// the executables land in build/bin, the test binary in build/bin/tests
-fs::path binDir() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path(); }
-
-fs::path temp(const std::string& name) {
-  return fs::temp_directory_path() / ("cave_deploy_test_" + std::to_string(::getpid()) + "_" + name);
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+using testutil::binDir;
+using testutil::slurp;
 
 // One swap per line of DIR/swaps.log: "step steady_ns".
 std::vector<std::pair<std::uint64_t, std::int64_t>> swaps(const fs::path& dir) {
@@ -65,13 +51,13 @@ TEST(CaveDeployment, TheWallViewsAreTheShippedWallsWithTheSwapBarrier) {
 TEST(CaveDeployment, TheCaveRehearsalSwapsTheSameStepsOnTheThreeWalls) {
   const fs::path file = fs::absolute(core::findData("configs/deployments/cave.yaml"));
   const fs::path checkout = file.parent_path().parent_path().parent_path();  // the services read configs/ from here
-  const fs::path run_dir = temp("run"), summary = temp("summary.json");
-  const std::string cmd = "cd " + checkout.string() + " && timeout 120 " + (binDir() / "mannequin-launch").string() + " " +
-                          file.string() + " --duration 10 --run-dir " + run_dir.string() + " --no-tty --summary-json " +
-                          summary.string() + " >/dev/null 2>&1";
-  const int st = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(st)) << cmd;
-  EXPECT_EQ(WEXITSTATUS(st), 0) << cmd;
+  const testutil::TempDir tmp("cave_deploy_test");
+  const fs::path run_dir = tmp / "run", summary = tmp / "summary.json";
+  const std::string cmd = (binDir() / "mannequin-launch").string() + " " + file.string() + " --duration 10 --run-dir " +
+                          run_dir.string() + " --no-tty --summary-json " + summary.string();
+  const testutil::ToolResult st = testutil::runTool(cmd, 120, checkout.string());
+  ASSERT_NE(st.exit_code, -1) << cmd;
+  EXPECT_EQ(st.exit_code, 0) << cmd;
   const std::string json = slurp(summary);
   for (const char* wall : kWalls) {  // each wall ran once, heartbeating, without a restart
     const auto at = json.find(std::string("\"name\": \"") + wall + "\"");

@@ -8,7 +8,6 @@
 #include <signal.h>
 #include <spawn.h>
 
-#include <array>
 #include <chrono>
 #include <map>
 #include <atomic>
@@ -16,8 +15,8 @@
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 
+#include "../common/tool_run.hpp"
 #include "fixtures.hpp"
 #include "mannequin/proto/schema.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
@@ -29,48 +28,25 @@ namespace fs = std::filesystem;
 namespace mannequin::render {
 namespace {
 
-// the tool lands in build/bin, the test binary in build/bin/tests
-fs::path toolPath() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "mannequin-render"; }
+using testutil::slurp;
+using testutil::ToolResult;
 
-fs::path temp(const std::string& name) {
-  return fs::temp_directory_path() / ("render_tool_test_" + std::to_string(::getpid()) + "_" + name);
+fs::path toolPath() { return testutil::binDir() / "mannequin-render"; }
+
+// Runs the tool under timeout(1) (a hung run fails at the deadline); `env` (e.g. "env -u DISPLAY",
+// "xvfb-run -a") goes between the deadline and the tool.
+ToolResult run(const std::string& args, const std::string& env = "", int timeout_s = 120) {
+  return testutil::runTool((env.empty() ? "" : env + " ") + toolPath().string() + " " + args, timeout_s);
 }
 
-struct ToolRun {
-  int status = -1;
-  std::string out, err;
+// Each test's files (temp(name)) in a directory of its own, removed after it.
+class RenderTool : public testutil::TempDirTest {
+ protected:
+  fs::path writeRecording() const;
 };
 
-// Runs the tool under timeout(1) (a hung run fails at the deadline); `env` prefixes the command.
-ToolRun run(const std::string& args, const std::string& env = "", int timeout_s = 120) {
-  ToolRun r;
-  const fs::path err = temp("stderr");
-  const std::string cmd = env + " timeout " + std::to_string(timeout_s) + " " + toolPath().string() + " " + args +
-                          " 2>" + err.string();
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf{};
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  std::ifstream in(err);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  fs::remove(err);
-  return r;
-}
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
-
 // Five sim.world messages of a standing male_50th, the last two with a 200 N contact force.
-fs::path writeRecording() {
+fs::path RenderTool::writeRecording() const {
   const fs::path path = temp("run.mcap");
   const skeleton::Model model = testing::male50();
   recording::McapWriter w(path.string());
@@ -93,60 +69,60 @@ fs::path writeRecording() {
   return path;
 }
 
-TEST(RenderTool, HelpListsTheOptions) {
-  const ToolRun r = run("--help");
-  EXPECT_EQ(r.status, 0) << r.err;
+TEST_F(RenderTool, HelpListsTheOptions) {
+  const ToolResult r = run("--help");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   for (const char* opt : {"--view", "--headless", "--size", "--out", "--every", "--frames", "--from", "--sim"})
     EXPECT_NE(r.out.find(opt), std::string::npos) << opt;
 }
 
-TEST(RenderTool, MissingOrInvalidViewFileExitsTwoNamingFileAndKey) {
-  const ToolRun missing = run("--view /nonexistent/v.yaml --headless --out " + temp("o").string());
-  EXPECT_EQ(missing.status, 2) << missing.err;
+TEST_F(RenderTool, MissingOrInvalidViewFileExitsTwoNamingFileAndKey) {
+  const ToolResult missing = run("--view /nonexistent/v.yaml --headless --out " + temp("o").string());
+  EXPECT_EQ(missing.exit_code, 2) << missing.err;
   EXPECT_NE(missing.err.find("/nonexistent/v.yaml"), std::string::npos) << missing.err;
 
   const fs::path bad = temp("bad_view.yaml");
   std::ofstream(bad) << "name: x\ntype: desktop\ncamera: {distance: 3, zoom: 2}\n";
-  const ToolRun invalid = run("--view " + bad.string() + " --headless --out " + temp("o").string());
-  EXPECT_EQ(invalid.status, 2) << invalid.err;
+  const ToolResult invalid = run("--view " + bad.string() + " --headless --out " + temp("o").string());
+  EXPECT_EQ(invalid.exit_code, 2) << invalid.err;
   EXPECT_NE(invalid.err.find(bad.string() + ":3"), std::string::npos) << invalid.err;
   EXPECT_NE(invalid.err.find("zoom"), std::string::npos) << invalid.err;
   fs::remove(bad);
 }
 
-TEST(RenderTool, NoDisplayWithoutHeadlessExitsTwoWithTheHint) {
-  const ToolRun r = run("--view configs/views/desktop.yaml", "env -u DISPLAY -u WAYLAND_DISPLAY");
-  EXPECT_EQ(r.status, 2) << r.err;
+TEST_F(RenderTool, NoDisplayWithoutHeadlessExitsTwoWithTheHint) {
+  const ToolResult r = run("--view configs/views/desktop.yaml", "env -u DISPLAY -u WAYLAND_DISPLAY");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find("no display"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("--headless"), std::string::npos) << r.err;
 }
 
-TEST(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
+TEST_F(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
   const fs::path mcap = writeRecording();
   const fs::path a = temp("a"), b = temp("b"), c = temp("c");
   const std::string common = "--view configs/views/desktop.yaml --scene configs/scenes/floor.yaml --headless --size 160x120 --from " +
                              mcap.string();
-  const ToolRun ra = run(common + " --every 2 --out " + a.string());
-  ASSERT_EQ(ra.status, 0) << ra.err;
+  const ToolResult ra = run(common + " --every 2 --out " + a.string());
+  ASSERT_EQ(ra.exit_code, 0) << ra.err;
   // every 2nd message: 0, 2, 4, named by message index
   std::vector<std::string> names;
   for (const auto& e : fs::directory_iterator(a)) names.push_back(e.path().filename().string());
   std::sort(names.begin(), names.end());
   EXPECT_EQ(names, (std::vector<std::string>{"frame_000000.png", "frame_000002.png", "frame_000004.png"}));
-  const ToolRun rb = run(common + " --every 2 --out " + b.string());
-  ASSERT_EQ(rb.status, 0) << rb.err;
+  const ToolResult rb = run(common + " --every 2 --out " + b.string());
+  ASSERT_EQ(rb.exit_code, 0) << rb.err;
   for (const auto& n : names) EXPECT_EQ(slurp(a / n), slurp(b / n)) << n << " differs between two runs";
   // the mannequin moves: consecutive frames differ
   EXPECT_NE(slurp(a / names[0]), slurp(a / names[1]));
   // --frames caps the count
-  const ToolRun rc = run(common + " --frames 2 --out " + c.string());
-  ASSERT_EQ(rc.status, 0) << rc.err;
+  const ToolResult rc = run(common + " --frames 2 --out " + c.string());
+  ASSERT_EQ(rc.exit_code, 0) << rc.err;
   EXPECT_EQ(std::distance(fs::directory_iterator(c), fs::directory_iterator{}), 2);
   EXPECT_NE(rc.out.find("wrote 2 frames (160x120)"), std::string::npos) << rc.out;
   // --overlay (a recording: step and sim time only) is deterministic too, and draws something
   const fs::path d = temp("d"), e = temp("e");
-  ASSERT_EQ(run(common + " --every 2 --overlay --out " + d.string()).status, 0);
-  ASSERT_EQ(run(common + " --every 2 --overlay --out " + e.string()).status, 0);
+  ASSERT_EQ(run(common + " --every 2 --overlay --out " + d.string()).exit_code, 0);
+  ASSERT_EQ(run(common + " --every 2 --overlay --out " + e.string()).exit_code, 0);
   for (const auto& n : names) {
     EXPECT_EQ(slurp(d / n), slurp(e / n)) << n << " with --overlay differs between two runs";
     EXPECT_NE(slurp(d / n), slurp(a / n)) << n << " is the same with and without --overlay";
@@ -155,7 +131,7 @@ TEST(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
   fs::remove(mcap);
 }
 
-TEST(RenderTool, RendersTheLiveSimWorldOfAPublisher) {
+TEST_F(RenderTool, RendersTheLiveSimWorldOfAPublisher) {
   zmq::context_t ctx;
   transport::Publisher pub(ctx, {"sim", {"tcp://127.0.0.1:0"}});
   const std::string endpoint = pub.boundEndpoints().at(0);
@@ -174,21 +150,21 @@ TEST(RenderTool, RendersTheLiveSimWorldOfAPublisher) {
     }
   });
   const fs::path out = temp("live");
-  const ToolRun r = run("--view configs/views/desktop.yaml --headless --size 160x120 --frames 3 --connect " + endpoint +
+  const ToolResult r = run("--view configs/views/desktop.yaml --headless --size 160x120 --frames 3 --connect " + endpoint +
                             " --out " + out.string(),
                         "", 60);
   done = true;
   publisher.join();
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("wrote 3 frames"), std::string::npos) << r.out;
   EXPECT_EQ(std::distance(fs::directory_iterator(out), fs::directory_iterator{}), 3);
   fs::remove_all(out);
   // --from and --connect exclude each other: a usage error
-  const ToolRun both = run("--headless --out " + out.string() + " --from x.mcap --connect " + endpoint);
-  EXPECT_EQ(both.status, 2) << both.err;
+  const ToolResult both = run("--headless --out " + out.string() + " --from x.mcap --connect " + endpoint);
+  EXPECT_EQ(both.exit_code, 2) << both.err;
 }
 
-TEST(RenderTool, AWallWithATrackedHeadDrawsWhatAFixedHeadThereDraws) {
+TEST_F(RenderTool, AWallWithATrackedHeadDrawsWhatAFixedHeadThereDraws) {
   // the same wall twice: a fixed head at E, and head_body "head" tracked at E by mocap.frame
   const std::string wall =
       "type: wall\nsize: [96, 96]\nwall: {lower_left: [1.5, 1.5, 0], lower_right: [1.5, -1.5, 0], upper_left: [1.5, 1.5, 3]}\n";
@@ -219,10 +195,10 @@ TEST(RenderTool, AWallWithATrackedHeadDrawsWhatAFixedHeadThereDraws) {
     }
   });
   const fs::path live = temp("tracked_out"), ref = temp("fixed_out");
-  const ToolRun r = run("--view " + tracked.string() + " --headless --frames 4 --connect " + endpoint + " --out " + live.string(), "", 60);
+  const ToolResult r = run("--view " + tracked.string() + " --headless --frames 4 --connect " + endpoint + " --out " + live.string(), "", 60);
   done = true;
   publisher.join();
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   const fs::path mcap = temp("one.mcap");
   {
     recording::McapWriter w(mcap.string());
@@ -231,8 +207,8 @@ TEST(RenderTool, AWallWithATrackedHeadDrawsWhatAFixedHeadThereDraws) {
     w.write(ch, 1, 0, 0, ws.SerializeAsString());
     w.close();
   }
-  const ToolRun rr = run("--view " + fixed.string() + " --headless --from " + mcap.string() + " --out " + ref.string());
-  ASSERT_EQ(rr.status, 0) << rr.err;
+  const ToolResult rr = run("--view " + fixed.string() + " --headless --from " + mcap.string() + " --out " + ref.string());
+  ASSERT_EQ(rr.exit_code, 0) << rr.err;
   std::vector<fs::path> frames;
   for (const auto& e : fs::directory_iterator(live)) frames.push_back(e.path());
   std::sort(frames.begin(), frames.end());
@@ -276,7 +252,7 @@ class WorldPublisher {
   std::thread thread_;
 };
 
-TEST(RenderTool, TheLauncherRunsARenderNodeLikeAnyService) {
+TEST_F(RenderTool, TheLauncherRunsARenderNodeLikeAnyService) {
   WorldPublisher world;
   const fs::path run_dir = temp("run"), out = temp("launched"), file = temp("deployment.yaml"), summary = temp("summary.json");
   fs::create_directories(run_dir);
@@ -286,11 +262,10 @@ TEST(RenderTool, TheLauncherRunsARenderNodeLikeAnyService) {
                       << ", --out, " << out.string() << "]\n"
                       << "    publish: ipc://${RUN_DIR}/wall\n";
   const fs::path launch = toolPath().parent_path() / "mannequin-launch";
-  const std::string cmd = "timeout 60 " + launch.string() + " " + file.string() + " --duration 3 --summary-json " +
-                          summary.string() + " >/dev/null 2>&1";
-  const int st = std::system(cmd.c_str());
-  ASSERT_TRUE(WIFEXITED(st)) << cmd;
-  EXPECT_EQ(WEXITSTATUS(st), 0) << cmd;
+  const std::string cmd = launch.string() + " " + file.string() + " --duration 3 --summary-json " + summary.string();
+  const ToolResult st = testutil::runTool(cmd, 60);
+  ASSERT_NE(st.exit_code, -1) << cmd;
+  EXPECT_EQ(st.exit_code, 0) << cmd;
   const std::string json = slurp(summary);
   // the launcher saw the node's heartbeats (started with --name wall --publish ipc://RUN_DIR/wall)
   const auto at = json.find("\"name\": \"wall\"");
@@ -344,7 +319,7 @@ int reap(pid_t pid, double deadline_s) {
   return -1;
 }
 
-TEST(RenderTool, SyncedNodesSwapTheSameStepsAndADeadNodeStallsNoLongerThanTheTimeout) {
+TEST_F(RenderTool, SyncedNodesSwapTheSameStepsAndADeadNodeStallsNoLongerThanTheTimeout) {
   // a state every 2 ms: faster than a node draws, so each node's newest state differs at any moment and
   // only the barrier makes them swap the same steps
   WorldPublisher world(std::chrono::milliseconds(2));
@@ -421,7 +396,7 @@ TEST(RenderTool, SyncedNodesSwapTheSameStepsAndADeadNodeStallsNoLongerThanTheTim
   for (const fs::path& d : dirs) fs::remove_all(d);
 }
 
-TEST(RenderTool, SyncedWindowsSwapTheStepsAHeadlessNodeSwaps) {
+TEST_F(RenderTool, SyncedWindowsSwapTheStepsAHeadlessNodeSwaps) {
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); windows with sync are not tested";
   WorldPublisher world(std::chrono::milliseconds(2));
@@ -475,29 +450,29 @@ TEST(RenderTool, SyncedWindowsSwapTheStepsAHeadlessNodeSwaps) {
   for (const fs::path& d : dirs) fs::remove_all(d);
 }
 
-TEST(RenderTool, OpensAWindowUnderXvfb) {
+TEST_F(RenderTool, OpensAWindowUnderXvfb) {
   if (std::system("command -v xvfb-run >/dev/null 2>&1") != 0)
     GTEST_SKIP() << "xvfb-run is not installed (tools/setup installs xvfb and xauth); the window path is not tested";
-  const ToolRun r = run("--view configs/views/desktop.yaml --scene configs/scenes/table.yaml --frames 3", "xvfb-run -a");
-  EXPECT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("--view configs/views/desktop.yaml --scene configs/scenes/table.yaml --frames 3", "xvfb-run -a");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.err.find("window 1280x720"), std::string::npos) << r.err;
 }
 
-TEST(RenderTool, AStereoWallWritesOneSideBySideImage) {
+TEST_F(RenderTool, AStereoWallWritesOneSideBySideImage) {
   const fs::path d = temp("stereo");
-  const ToolRun r = run("--view configs/views/wall_front_stereo.yaml --scene configs/scenes/table.yaml --headless --size 200x100 --out " +
+  const ToolResult r = run("--view configs/views/wall_front_stereo.yaml --scene configs/scenes/table.yaml --headless --size 200x100 --out " +
                         d.string());
-  EXPECT_EQ(r.status, 0) << r.err;
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("wrote 1 frames (200x100)"), std::string::npos) << r.out;
   EXPECT_TRUE(fs::exists(d / "frame_000000.png"));
 }
 
-TEST(RenderTool, BadSizeAndMissingOutAreUsageErrors) {
-  const ToolRun size = run("--headless --size 12x --out " + temp("o").string());
-  EXPECT_EQ(size.status, 2) << size.err;
+TEST_F(RenderTool, BadSizeAndMissingOutAreUsageErrors) {
+  const ToolResult size = run("--headless --size 12x --out " + temp("o").string());
+  EXPECT_EQ(size.exit_code, 2) << size.err;
   EXPECT_NE((size.err + size.out).find("WIDTHxHEIGHT"), std::string::npos) << size.err;
-  const ToolRun out = run("--headless");
-  EXPECT_EQ(out.status, 2) << out.err;
+  const ToolResult out = run("--headless");
+  EXPECT_EQ(out.exit_code, 2) << out.err;
   EXPECT_NE(out.err.find("--out"), std::string::npos) << out.err;
 }
 

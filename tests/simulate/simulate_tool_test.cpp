@@ -3,58 +3,29 @@
 // numbers twice but for the wall-clock ones), and the --out MCAP file read back as sim.world messages.
 #include <gtest/gtest.h>
 #include <mannequin/v1/world.pb.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <array>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
 #include <optional>
 #include <regex>
-#include <sstream>
 #include <string>
 #include <utility>
 
+#include "../common/tool_run.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
 
 namespace fs = std::filesystem;
 
 namespace {
 
-// the tool lands in build/bin, the test binary in build/bin/tests
-fs::path toolPath() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "mannequin-simulate"; }
+using mannequin::testutil::ToolResult;
 
-fs::path temp(const std::string& name) {
-  return fs::temp_directory_path() / ("simulate_tool_test_" + std::to_string(::getpid()) + "_" + name);
-}
+fs::path toolPath() { return mannequin::testutil::binDir() / "mannequin-simulate"; }
 
-struct ToolRun {
-  int status = -1;
-  std::string out, err;
-};
-
-// Runs the tool under timeout(1) (a hung run fails at the deadline instead of hanging the suite);
-// stdout captured, stderr to a file.
-ToolRun run(const std::string& args, int timeout_s = 240) {
-  ToolRun r;
-  const fs::path err = temp("stderr");
-  const std::string cmd = "timeout " + std::to_string(timeout_s) + " " + toolPath().string() + " " + args + " 2>" + err.string();
-  FILE* p = ::popen(cmd.c_str(), "r");
-  if (p == nullptr) return r;
-  std::array<char, 4096> buf{};
-  std::size_t n;
-  while ((n = std::fread(buf.data(), 1, buf.size(), p)) > 0) r.out.append(buf.data(), n);
-  const int st = ::pclose(p);
-  r.status = WIFEXITED(st) ? WEXITSTATUS(st) : -1;
-  std::ifstream in(err);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  r.err = ss.str();
-  fs::remove(err);
-  return r;
+// Runs the tool under timeout(1) (a hung run fails at the deadline instead of hanging the suite).
+ToolResult run(const std::string& args, int timeout_s = 240) {
+  return mannequin::testutil::runTool(toolPath().string() + " " + args, timeout_s);
 }
 
 const char* kKeys[] = {"frames", "steps", "sim_time_s", "wall_s", "nan_steps", "lcp_failures", "max_penetration_m",
@@ -69,17 +40,6 @@ std::optional<double> number(const std::string& json, const std::string& key) {
   return std::stod(m[1].str());
 }
 
-// Runs python3 on `json` with `script` (d = json.loads of it); its stdout and exit status.
-std::pair<int, std::string> pythonOn(const std::string& json, const std::string& script) {
-  const fs::path in = temp("out.json"), py = temp("check.py"), out = temp("check.txt");
-  std::ofstream(in) << json;
-  std::ofstream(py) << "import json, sys\nd = json.loads(open(sys.argv[1]).read())\n" << script << "\n";
-  const int st = std::system(("timeout 60 python3 " + py.string() + " " + in.string() + " >" + out.string() + " 2>&1").c_str());
-  std::ifstream o(out);
-  std::stringstream text;
-  text << o.rdbuf();
-  return {WIFEXITED(st) ? WEXITSTATUS(st) : -1, text.str()};
-}
 
 // The JSON without the wall-clock keys (the rest must be bit-identical between runs).
 std::string withoutWallClock(std::string json) {
@@ -88,21 +48,34 @@ std::string withoutWallClock(std::string json) {
   return json;
 }
 
+// Each test's files (temp(name)) in a directory of its own, removed after it.
+class SimulateTool : public mannequin::testutil::TempDirTest {
+ protected:
+  // Runs python3 on `json` with `script` (d = json.loads of it); its exit status and stdout+stderr.
+  std::pair<int, std::string> pythonOn(const std::string& json, const std::string& script) const {
+    const fs::path in = temp("out.json");
+    std::ofstream(in) << json;
+    const ToolResult r = mannequin::testutil::runPython(
+        dir_, "import json, sys\nd = json.loads(open(sys.argv[1]).read())\n" + script, in.string());
+    return {r.exit_code, r.out};
+  }
+};
+
 }  // namespace
 
-TEST(SimulateTool, HelpExitsZero) {
+TEST_F(SimulateTool, HelpExitsZero) {
   ASSERT_TRUE(fs::exists(toolPath())) << toolPath();
-  const ToolRun r = run("--help");
-  EXPECT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("--help");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("--duration"), std::string::npos) << r.out;
 }
 
-TEST(SimulateTool, BadConfigNamesFileAndLineAndExitsTwo) {
+TEST_F(SimulateTool, BadConfigNamesFileAndLineAndExitsTwo) {
   const fs::path cfg = temp("bad.yaml");
   std::ofstream(cfg) << "name: sim\nstep: 0.001\nphysics: {enabled: true, scene: configs/scenes/floor.yaml, friction_edge: 4}\n"
                         "mannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, control_frames: {pelvis: pelvis}}\n";
-  const ToolRun r = run("--config " + cfg.string() + " --json");
-  EXPECT_EQ(r.status, 2) << r.err;
+  const ToolResult r = run("--config " + cfg.string() + " --json");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
   EXPECT_NE(r.err.find(cfg.string() + ":3"), std::string::npos) << r.err;
   EXPECT_NE(r.err.find("friction_edge"), std::string::npos) << r.err;
   EXPECT_TRUE(r.out.empty()) << r.out;
@@ -111,19 +84,19 @@ TEST(SimulateTool, BadConfigNamesFileAndLineAndExitsTwo) {
   const fs::path scene = temp("bad_scene.yaml");
   std::ofstream(scene) << "name: s\nbodies:\n  - name: floor\n    shapes: [{type: plane, normal: [0, 0, 1], offset: 0}]\n"
                           "  - name: ball\n    shapes: [{type: sphere, radius: -1}]\n";
-  const ToolRun s = run("--scene " + scene.string() + " --json");
-  EXPECT_EQ(s.status, 2) << s.err;
+  const ToolResult s = run("--scene " + scene.string() + " --json");
+  EXPECT_EQ(s.exit_code, 2) << s.err;
   EXPECT_NE(s.err.find(scene.string() + ":"), std::string::npos) << s.err;
   fs::remove(cfg);
   fs::remove(scene);
 }
 
-TEST(SimulateTool, BadMannequinMocapAndCaptureFilesNameFileAndLineAndExitTwo) {
+TEST_F(SimulateTool, BadMannequinMocapAndCaptureFilesNameFileAndLineAndExitTwo) {
   // a mannequin config with a typo on line 3
   const fs::path mannequin = temp("bad_mannequin.yaml");
   std::ofstream(mannequin) << "name: m\nstature_m: 1.75\nmass_kgg: 70\n";
-  const ToolRun m = run("--mannequin " + mannequin.string() + " --duration 0.01 --json");
-  EXPECT_EQ(m.status, 2) << m.err;
+  const ToolResult m = run("--mannequin " + mannequin.string() + " --duration 0.01 --json");
+  EXPECT_EQ(m.exit_code, 2) << m.err;
   EXPECT_NE(m.err.find(mannequin.string() + ":3"), std::string::npos) << m.err;
   EXPECT_NE(m.err.find("mass_kgg"), std::string::npos) << m.err;
   EXPECT_TRUE(m.out.empty()) << m.out;
@@ -135,29 +108,29 @@ TEST(SimulateTool, BadMannequinMocapAndCaptureFilesNameFileAndLineAndExitTwo) {
   const fs::path cfg = temp("mocap_cfg.yaml");
   std::ofstream(cfg) << "name: sim\nstep: 0.001\nphysics: {enabled: true, scene: configs/scenes/floor.yaml}\nmocap: " << mocap.string()
                      << "\nmannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, control_frames: {pelvis: pelvis}}\n";
-  const ToolRun c = run("--config " + cfg.string() + " --duration 0.01 --json");
-  EXPECT_EQ(c.status, 2) << c.err;
+  const ToolResult c = run("--config " + cfg.string() + " --duration 0.01 --json");
+  EXPECT_EQ(c.exit_code, 2) << c.err;
   EXPECT_NE(c.err.find(mocap.string() + ":4"), std::string::npos) << c.err;
   EXPECT_NE(c.err.find("rate"), std::string::npos) << c.err;
   // a mocap config that is not a BVH capture: the line of its `source`
   std::ofstream(mocap) << "name: mocap\n\nsource: synthetic\nsynthetic: {rate_hz: 120}\n";
-  const ToolRun k = run("--config " + cfg.string() + " --duration 0.01 --json");
-  EXPECT_EQ(k.status, 2) << k.err;
+  const ToolResult k = run("--config " + cfg.string() + " --duration 0.01 --json");
+  EXPECT_EQ(k.exit_code, 2) << k.err;
   EXPECT_NE(k.err.find(mocap.string() + ":3"), std::string::npos) << k.err;
 
   // a broken BVH capture (--mocap): the BVH file's own line
   const fs::path bvh = temp("bad.bvh");
   std::ofstream(bvh) << "HIERARCHY\nROOT Hips\n{\n  OFFSET 0 0\n";
-  const ToolRun b = run("--mocap " + bvh.string() + " --duration 0.01 --json");
-  EXPECT_EQ(b.status, 2) << b.err;
+  const ToolResult b = run("--mocap " + bvh.string() + " --duration 0.01 --json");
+  EXPECT_EQ(b.exit_code, 2) << b.err;
   EXPECT_NE(b.err.find(bvh.string() + ":"), std::string::npos) << b.err;
   EXPECT_TRUE(b.out.empty()) << b.out;
   for (const fs::path& p : {mannequin, mocap, cfg, bvh}) fs::remove(p);
 }
 
-TEST(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {
-  const ToolRun a = run("--config configs/sim/sim_demo.yaml --duration 1 --json");
-  ASSERT_EQ(a.status, 0) << a.err;
+TEST_F(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {
+  const ToolResult a = run("--config configs/sim/sim_demo.yaml --duration 1 --json");
+  ASSERT_EQ(a.exit_code, 0) << a.err;
   // exactly one JSON object on stdout, on one line (python's json module reads it as a dict)
   ASSERT_FALSE(a.out.empty());
   EXPECT_EQ(a.out.front(), '{') << a.out;
@@ -204,15 +177,15 @@ TEST(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {
   EXPECT_LT(balance, 0.2) << a.out;
   EXPECT_GT(balance, -0.3) << a.out;
 
-  const ToolRun b = run("--config configs/sim/sim_demo.yaml --duration 1 --json");
-  ASSERT_EQ(b.status, 0) << b.err;
+  const ToolResult b = run("--config configs/sim/sim_demo.yaml --duration 1 --json");
+  ASSERT_EQ(b.exit_code, 0) << b.err;
   EXPECT_EQ(withoutWallClock(a.out), withoutWallClock(b.out));
 }
 
-TEST(SimulateTool, OutFileHoldsSimWorldMessagesAtTheWorldRate) {
+TEST_F(SimulateTool, OutFileHoldsSimWorldMessagesAtTheWorldRate) {
   const fs::path mcap = temp("run.mcap");
-  const ToolRun r = run("--config configs/sim/sim_demo.yaml --duration 0.5 --out " + mcap.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("--config configs/sim/sim_demo.yaml --duration 0.5 --out " + mcap.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   const mannequin::recording::McapReader reader = mannequin::recording::McapReader::open(mcap.string());
   EXPECT_TRUE(reader.indexed());
   ASSERT_EQ(reader.channels().size(), 1u);
@@ -250,12 +223,12 @@ TEST(SimulateTool, OutFileHoldsSimWorldMessagesAtTheWorldRate) {
   fs::remove(mcap);
 }
 
-TEST(SimulateTool, OutFileCarriesTheSceneObjects) {
+TEST_F(SimulateTool, OutFileCarriesTheSceneObjects) {
   // configs/scenes/table.yaml: the ball and the tray (movable, with a mass) rest on the table top
   // (z = 0.75 m); every sim.world carries them where the scene put them
   const fs::path mcap = temp("objects.mcap");
-  const ToolRun r = run("--config configs/sim/sim_demo.yaml --scene configs/scenes/table.yaml --duration 0.3 --out " + mcap.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("--config configs/sim/sim_demo.yaml --scene configs/scenes/table.yaml --duration 0.3 --out " + mcap.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   const auto messages = mannequin::recording::McapReader::open(mcap.string()).readAll();
   ASSERT_EQ(messages.size(), 18u);  // 0.3 s at 60 Hz
   for (const auto& m : messages) {

@@ -2,15 +2,12 @@
 // public key of a secret file, and one-line errors with exit 2.
 #include <gtest/gtest.h>
 #include <sys/stat.h>
-#include <sys/wait.h>
-#include <unistd.h>
 
-#include <cstdlib>
 #include <filesystem>
 #include <fstream>
-#include <sstream>
 #include <string>
 
+#include "../common/tool_run.hpp"
 #include "mannequin/transport/security.hpp"
 
 namespace fs = std::filesystem;
@@ -18,20 +15,10 @@ using namespace mannequin::transport;
 
 namespace {
 
-struct ToolRun {
-  int status = -1;
-  std::string out, err;
-};
+using mannequin::testutil::slurp;
+using mannequin::testutil::ToolResult;
 
-// the tool lands in build/bin, the test binary in build/bin/tests
-fs::path toolPath() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path() / "mannequin-keys"; }
-
-std::string slurp(const fs::path& p) {
-  std::ifstream in(p, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+fs::path toolPath() { return mannequin::testutil::binDir() / "mannequin-keys"; }
 
 unsigned modeOf(const fs::path& p) {
   struct stat st {};
@@ -39,37 +26,22 @@ unsigned modeOf(const fs::path& p) {
   return st.st_mode & 07777;
 }
 
-class KeysTool : public ::testing::Test {
+class KeysTool : public mannequin::testutil::TempDirTest {
  protected:
   void SetUp() override {
     ASSERT_TRUE(fs::exists(toolPath())) << toolPath();
     if (!hasCurve()) GTEST_SKIP() << "libzmq without CURVE";
-    dir_ = fs::temp_directory_path() / ("keys_tool_test_" + std::to_string(::getpid()) + "_" +
-                                        ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
   }
-  void TearDown() override { fs::remove_all(dir_); }
 
-  ToolRun run(const std::string& args) {
-    const fs::path out = dir_ / "stdout", err = dir_ / "stderr";
-    // under timeout(1): a hung tool fails the test at the deadline instead of hanging ctest
-    const std::string cmd = "timeout 60 " + toolPath().string() + " " + args + " >" + out.string() + " 2>" + err.string();
-    const int raw = std::system(cmd.c_str());
-    ToolRun r;
-    r.status = WIFEXITED(raw) ? WEXITSTATUS(raw) : -1;
-    r.out = slurp(out);
-    r.err = slurp(err);
-    return r;
-  }
-  fs::path dir_;
+  // under timeout(1): a hung tool fails the test at the deadline instead of hanging ctest
+  ToolResult run(const std::string& args) { return mannequin::testutil::runTool(toolPath().string() + " " + args, 60); }
 };
 
 }  // namespace
 
 TEST_F(KeysTool, GenerateWritesAPairWithASecretOfMode0600) {
-  const ToolRun r = run("generate sim --dir " + dir_.string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  const ToolResult r = run("generate sim --dir " + dir_.path().string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   const fs::path pub = dir_ / "sim.key", sec = dir_ / "sim.key_secret";
   ASSERT_TRUE(fs::exists(pub));
   ASSERT_TRUE(fs::exists(sec));
@@ -80,62 +52,62 @@ TEST_F(KeysTool, GenerateWritesAPairWithASecretOfMode0600) {
   EXPECT_EQ(curvePublicKey(secret_key), public_key);  // a real pair
   EXPECT_NE(r.out.find(public_key), std::string::npos) << r.out;
   // a second pair is another pair
-  ASSERT_EQ(run("generate render1 --dir " + dir_.string()).status, 0);
+  ASSERT_EQ(run("generate render1 --dir " + dir_.path().string()).exit_code, 0);
   EXPECT_NE(readKeyFile((dir_ / "render1.key").string(), false), public_key);
 }
 
 TEST_F(KeysTool, GenerateRefusesToOverwriteNamingTheFile) {
-  ASSERT_EQ(run("generate sim --dir " + dir_.string()).status, 0);
+  ASSERT_EQ(run("generate sim --dir " + dir_.path().string()).exit_code, 0);
   const std::string secret_before = slurp(dir_ / "sim.key_secret"), public_before = slurp(dir_ / "sim.key");
-  const ToolRun r = run("generate sim --dir " + dir_.string());
-  EXPECT_EQ(r.status, 2);
+  const ToolResult r = run("generate sim --dir " + dir_.path().string());
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find((dir_ / "sim.key").string() + ": already exists"), std::string::npos) << r.err;
   EXPECT_EQ(slurp(dir_ / "sim.key_secret"), secret_before);
   EXPECT_EQ(slurp(dir_ / "sim.key"), public_before);
   // only the secret left over: still refused, and no public file written beside it
   fs::remove(dir_ / "sim.key");
-  const ToolRun r2 = run("generate sim --dir " + dir_.string());
-  EXPECT_EQ(r2.status, 2);
+  const ToolResult r2 = run("generate sim --dir " + dir_.path().string());
+  EXPECT_EQ(r2.exit_code, 2);
   EXPECT_NE(r2.err.find((dir_ / "sim.key_secret").string() + ": already exists"), std::string::npos) << r2.err;
   EXPECT_FALSE(fs::exists(dir_ / "sim.key"));
 }
 
 TEST_F(KeysTool, PublicPrintsThePublicKeyOfASecretFile) {
-  ASSERT_EQ(run("generate mocap --dir " + dir_.string()).status, 0);
-  const ToolRun r = run("public " + (dir_ / "mocap.key_secret").string());
-  ASSERT_EQ(r.status, 0) << r.err;
+  ASSERT_EQ(run("generate mocap --dir " + dir_.path().string()).exit_code, 0);
+  const ToolResult r = run("public " + (dir_ / "mocap.key_secret").string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, readKeyFile((dir_ / "mocap.key").string(), false) + "\n");
 }
 
 TEST_F(KeysTool, BadInputIsOneLineAndExit2) {
   auto oneLine = [](const std::string& s) { return !s.empty() && s.find('\n') == s.size() - 1; };
-  ToolRun r = run("public " + (dir_ / "none.key_secret").string());
-  EXPECT_EQ(r.status, 2);
+  ToolResult r = run("public " + (dir_ / "none.key_secret").string());
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(oneLine(r.err)) << r.err;
   EXPECT_NE(r.err.find("none.key_secret"), std::string::npos) << r.err;
 
   std::ofstream(dir_ / "bad.key_secret") << "garbage\n";
   fs::permissions(dir_ / "bad.key_secret", fs::perms::owner_read | fs::perms::owner_write);
   r = run("public " + (dir_ / "bad.key_secret").string());
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(oneLine(r.err)) << r.err;
   EXPECT_NE(r.err.find("bad.key_secret:1: not a Z85 CURVE key"), std::string::npos) << r.err;
 
-  ASSERT_EQ(run("generate open --dir " + dir_.string()).status, 0);
+  ASSERT_EQ(run("generate open --dir " + dir_.path().string()).exit_code, 0);
   fs::permissions(dir_ / "open.key_secret", fs::perms::others_read, fs::perm_options::add);
   r = run("public " + (dir_ / "open.key_secret").string());
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("readable by others"), std::string::npos) << r.err;
 
-  r = run("generate ../escape --dir " + dir_.string());
-  EXPECT_EQ(r.status, 2);
+  r = run("generate ../escape --dir " + dir_.path().string());
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_TRUE(oneLine(r.err)) << r.err;
   r = run("generate x --dir " + (dir_ / "no-such-dir").string());
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("no-such-dir"), std::string::npos) << r.err;
   r = run("frobnicate");
-  EXPECT_EQ(r.status, 2);
+  EXPECT_EQ(r.exit_code, 2);
   r = run("");
-  EXPECT_EQ(r.status, 2);
-  EXPECT_EQ(run("--help").status, 0);
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_EQ(run("--help").exit_code, 0);
 }
