@@ -180,6 +180,14 @@ TEST(WorldBalanceController, Fig318TheWorkerLeansOnTheWallToHoldTheMarginAndReac
   const math::Vector3 wall_hand(wallFace() - 0.06, standingPosition("hand_l").y() + 0.05, 1.25);
   const math::Vector3 reach = standingPosition("hand_r") + math::Vector3(0.25, -0.05, 0.15);
   const double F = 150.0;
+  std::printf("set-up: wall face x = %.3f m; standing hands l (%.3f %.3f %.3f) r (%.3f %.3f %.3f), pelvis (%.3f %.3f %.3f), "
+              "head (%.3f %.3f %.3f), feet l (%.3f %.3f %.3f) r (%.3f %.3f %.3f)\n", wallFace(),
+              standingPosition("hand_l").x(), standingPosition("hand_l").y(), standingPosition("hand_l").z(),
+              standingPosition("hand_r").x(), standingPosition("hand_r").y(), standingPosition("hand_r").z(),
+              standingPosition("pelvis").x(), standingPosition("pelvis").y(), standingPosition("pelvis").z(),
+              standingPosition("head").x(), standingPosition("head").y(), standingPosition("head").z(),
+              standingPosition("foot_l").x(), standingPosition("foot_l").y(), standingPosition("foot_l").z(),
+              standingPosition("foot_r").x(), standingPosition("foot_r").y(), standingPosition("foot_r").z());
   const WorkerRun off = runWorker(false, F, wall_hand, reach);
   const WorkerRun on = runWorker(true, F, wall_hand, reach);
   // the feet alone: a fraction of the margin, and that fraction held

@@ -112,11 +112,17 @@ TEST_F(SimulateTool, BadMannequinMocapAndCaptureFilesNameFileAndLineAndExitTwo) 
   EXPECT_EQ(c.exit_code, 2) << c.err;
   EXPECT_NE(c.err.find(mocap.string() + ":4"), std::string::npos) << c.err;
   EXPECT_NE(c.err.find("rate"), std::string::npos) << c.err;
-  // a mocap config that is not a BVH capture: the line of its `source`
-  std::ofstream(mocap) << "name: mocap\n\nsource: synthetic\nsynthetic: {rate_hz: 120}\n";
+  // a mocap config that is neither a BVH capture nor a scripted one: the line of its `source`
+  std::ofstream(mocap) << "name: mocap\n\nsource: dtrack2\ndtrack2: {port: 5000}\n";
   const ToolResult k = run("--config " + cfg.string() + " --duration 0.01 --json");
   EXPECT_EQ(k.exit_code, 2) << k.err;
   EXPECT_NE(k.err.find(mocap.string() + ":3"), std::string::npos) << k.err;
+  // a scripted capture without an end: the line of its `synthetic` section, naming the duration
+  std::ofstream(mocap) << "name: mocap\n\nsource: synthetic\nsynthetic: {rate_hz: 120}\n";
+  const ToolResult e = run("--config " + cfg.string() + " --duration 0.01 --json");
+  EXPECT_EQ(e.exit_code, 2) << e.err;
+  EXPECT_NE(e.err.find(mocap.string() + ":4"), std::string::npos) << e.err;
+  EXPECT_NE(e.err.find("duration"), std::string::npos) << e.err;
 
   // a broken BVH capture (--mocap): the BVH file's own line
   const fs::path bvh = temp("bad.bvh");
@@ -126,6 +132,34 @@ TEST_F(SimulateTool, BadMannequinMocapAndCaptureFilesNameFileAndLineAndExitTwo) 
   EXPECT_NE(b.err.find(bvh.string() + ":"), std::string::npos) << b.err;
   EXPECT_TRUE(b.out.empty()) << b.out;
   for (const fs::path& p : {mannequin, mocap, cfg, bvh}) fs::remove(p);
+}
+
+// The shipped leaning worker (configs/sim/sim_lean.yaml, docs/balance.md): the balance controller asks for
+// ±150 N fore-aft pushes at the CoM. The feet alone hold at most ≈ 127 N (m g × half the sole length / CoM
+// height), so the whole margin can only be held while the left hand is on the wall (the scripted actor puts it
+// there around 4 s of the 8): some of the run, not all of it. The margin the World measures (the largest
+// horizontal push in any of ±x, ±y the contacts hold) never drops to 0 (the posture always has an equilibrium).
+TEST_F(SimulateTool, TheLeaningWorkerHoldsTheWholeMarginOnlyWithTheHandOnTheWall) {
+  const ToolResult a = run("--config configs/sim/sim_lean.yaml --json", 300);
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  const auto [status, out] = pythonOn(
+      a.out,
+      "b = d['balance_controller']\nassert b['enabled'] is True, b\nassert b['failures'] == 0, b\n"
+      "assert b['solves'] >= 800, b\nassert b['driving_fraction'] > 0.95, b\n"
+      "assert 0.05 < b['full_margin_fraction'] < 0.95, b\n"
+      "assert d['nan_steps'] == 0 and d['max_penetration_m'] < 0.01, d\n"
+      "assert d['min_force_margin_n'] > 0, d\nassert abs(d['sim_time_s'] - 8.0) < 0.02, d\nprint('ok')");
+  EXPECT_EQ(status, 0) << out << a.out;
+  // a bad balance controller setting: exit 2 naming the file, line and field
+  const fs::path cfg = temp("bad_balance.yaml");
+  std::ofstream(cfg) << "name: sim\nstep: 0.001\nphysics:\n  enabled: true\n  scene: configs/scenes/bay.yaml\n"
+                        "  balance_controller: {enabled: true, force_margin: [[150, 0, 0]]}\n"
+                        "mannequins:\n  - {name: a, config: configs/mannequins/male_50th.yaml, control_frames: {pelvis: pelvis}}\n";
+  const ToolResult r = run("--config " + cfg.string() + " --json");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(cfg.string() + ":6"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("force_margin"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
 TEST_F(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {

@@ -42,12 +42,15 @@ void printJson(const Summary& s) {
       "\"physics\": %s, \"nan_steps\": %lld, \"lcp_failures\": %lld, \"max_penetration_m\": %s, \"max_contacts\": %d, "
       "\"mean_contacts\": %s, \"foot_contact_fraction\": %s, \"min_balance_distance_m\": %s, "
       "\"worst_joint_limit_excess_rad\": %s, \"min_force_margin_n\": %s, \"mean_force_margin_n\": %s, "
+      "\"balance_controller\": {\"enabled\": %s, \"solves\": %lld, \"failures\": %lld, \"driving_fraction\": %s, "
+      "\"full_margin_fraction\": %s}, "
       "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld, \"ergonomics\": %s}\n",
       s.frames, s.steps, num(s.sim_time_s).c_str(), num(s.wall_s).c_str(), num(s.realtimeFactor()).c_str(),
       s.physics ? "true" : "false", s.nan_steps, s.lcp_failures, num(s.max_penetration_m).c_str(), s.max_contacts,
       num(s.meanContacts()).c_str(), num(s.footContactFraction()).c_str(), num(s.min_balance_distance_m).c_str(),
       num(s.worst_joint_limit_excess_rad).c_str(), num(s.min_force_margin_n).c_str(), num(s.meanForceMargin()).c_str(),
-      num(s.meanHandError()).c_str(), num(s.meanFootError()).c_str(),
+      s.balance_controller ? "true" : "false", s.balance_solves, s.balance_failures, num(s.balanceDrivingFraction()).c_str(),
+      num(s.balanceFullMarginFraction()).c_str(), num(s.meanHandError()).c_str(), num(s.meanFootError()).c_str(),
       s.worlds, ergonomicsJson(s).c_str());
 }
 
@@ -68,6 +71,10 @@ void printHuman(const Summary& s, const std::string& out) {
                   s.min_force_margin_n, s.meanForceMargin());
     else
       std::printf("margin      not evaluated (physics.force_margin_period: 0)\n");
+    if (s.balance_controller)
+      std::printf("controller  balance (Alg. 5) drove %.1f %% of the mannequin-steps, the whole margin held in %.1f %% of them; "
+                  "%lld solves, %lld failed updates\n",
+                  100.0 * s.balanceDrivingFraction(), 100.0 * s.balanceFullMarginFraction(), s.balance_solves, s.balance_failures);
     std::printf("limits      worst excess %.4f rad\n", s.worst_joint_limit_excess_rad);
   } else {
     std::printf("physics     off (sim config `physics: {enabled: true, scene: ...}` or --scene turns it on)\n");

@@ -26,7 +26,8 @@ std::string resolvePath(const ConfigNode& node) {
 void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
   ph.allowOnly({"enabled", "gravity", "scene", "segment_margin", "segment_material", "self_collision", "query_period_steps", "activation_distance",
                 "calibration_clearance", "friction_edges", "recovery_speed", "max_rows", "balance_rows",
-                "foot_contact_tolerance", "object_time_constant", "balance_ellipse", "force_margin_period", "force_margin_max"});
+                "foot_contact_tolerance", "object_time_constant", "balance_ellipse", "force_margin_period", "force_margin_max",
+                "balance_controller"});
   p.enabled = ph.get("enabled", p.enabled);
   if (auto g = ph.find("gravity")) p.gravity = g->vec3();
   if (auto sc = ph.find("scene")) {
@@ -59,6 +60,28 @@ void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
   p.object_time_constant = ph.getIn("object_time_constant", p.object_time_constant, 1e-4, 10.0);
   p.force_margin_period = ph.getIn("force_margin_period", p.force_margin_period, 0.0, 3600.0);
   p.force_margin_max = ph.getIn("force_margin_max", p.force_margin_max, 1.0, 1e6);
+  if (auto bc = ph.find("balance_controller")) {
+    // the multi-contact balance controller in the loop (docs/balance.md)
+    bc->allowOnly({"enabled", "period", "frames", "force_margins", "edges", "max_step", "max_task_step", "dq_weight",
+                   "posture_gain", "joint_stiffness", "joint_damping"});
+    sim::BalanceControllerConfig& b = p.balance_controller;
+    b.enabled = bc->get("enabled", true);
+    b.period = bc->getIn("period", b.period, 1e-4, 10.0);
+    if (auto f = bc->find("frames")) b.frames = f->strings();
+    if (auto fm = bc->find("force_margins")) {
+      b.force_margins.clear();
+      for (const ConfigNode& v : fm->items()) b.force_margins.push_back(v.vec3());
+    }
+    b.edges = bc->get("edges", b.edges);
+    if (b.edges < 3 || b.edges > 32) (*bc)["edges"].fail("must be in [3, 32]");
+    b.max_step = bc->getIn("max_step", b.max_step, 1e-5, 1.0);
+    b.max_task_step = bc->getIn("max_task_step", b.max_task_step, 1e-5, 1.0);
+    b.dq_weight = bc->getIn("dq_weight", b.dq_weight, 1e-6, 1e12);
+    b.posture_gain = bc->getIn("posture_gain", b.posture_gain, 0.0, 1.0);
+    b.joint_stiffness = bc->getIn("joint_stiffness", b.joint_stiffness, 0.0, 1e6);
+    b.joint_damping = bc->getIn("joint_damping", b.joint_damping, 0.0, 1e6);
+    if (b.enabled && !p.enabled) (*bc)["enabled"].fail("needs physics.enabled (the contacts come from the physics)");
+  }
 }
 
 SimServiceConfig parseSimConfig(const ConfigNode& root) {

@@ -126,6 +126,8 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
       ms->set_sole_height(md.sole_height_m);
       ms->set_worst_joint_limit_excess(md.worst_joint_limit_excess_rad);
       ms->set_force_margin(md.force_margin_n);
+      ms->set_balance_driving(md.balance_driving);
+      ms->set_balance_margin_fraction(md.balance_margin_fraction);
       // the World's contacts touching this mannequin's segments (bodies "<name>/<segment>")
       const std::string prefix = world.name(i) + "/";
       for (const sim::ContactReport& k : world.contacts()) {

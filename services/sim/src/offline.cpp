@@ -53,6 +53,11 @@ void accumulate(const sim::World& world, bool ok, OfflineSummary& s) {
           (!std::isfinite(s.min_balance_distance_m) || md.balance_distance_m < s.min_balance_distance_m))
         s.min_balance_distance_m = md.balance_distance_m;
       s.worst_joint_limit_excess_rad = std::max(s.worst_joint_limit_excess_rad, md.worst_joint_limit_excess_rad);
+      ++s.mannequin_steps;
+      if (md.balance_driving) {
+        ++s.balance_driving_steps;
+        if (md.balance_margin_fraction >= 1.0) ++s.balance_full_margin_steps;
+      }
       if (std::isfinite(md.force_margin_n)) {
         if (!(md.force_margin_n >= s.min_force_margin_n)) s.min_force_margin_n = md.force_margin_n;  // NaN: the first
         s.force_margin_sum += md.force_margin_n;
@@ -165,19 +170,33 @@ OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
         throw core::ConfigError(fmt::format("{}:{}: {}", mocap_path, e.mark.line + 1, e.msg));
       }
       if (!raw.IsMap()) throw core::ConfigError(mocap_path + ":1: a mocap config (a map with `source: bvh` and a `bvh` section)");
-      if (!raw["source"] || raw["source"].as<std::string>("") != "bvh" || !raw["bvh"]) {
+      const bool scripted = raw["source"] && raw["source"].as<std::string>("") == "synthetic" && raw["synthetic"] && options.mocap.empty();
+      if (scripted) {
+        // a scripted capture (source: synthetic, e.g. configs/sim/mocap_lean.yaml): its `duration` once, unpaced
+        const double duration = raw["synthetic"]["duration"].as<double>(0.0);
+        if (!(duration > 0))
+          throw core::ConfigError(fmt::format("{}:{}: field 'synthetic.duration': mannequin-simulate needs a scripted capture of "
+                                              "finite length (duration > 0 s)", mocap_path, raw["synthetic"].Mark().line + 1));
+        raw["synthetic"]["paced"] = false;
+        capture_file_ = mocap_path;
+        source_ = mocap::makeSource(core::ConfigNode(raw, mocap_path));
+        capture_length_s_ = duration;
+      } else if (!raw["source"] || raw["source"].as<std::string>("") != "bvh" || !raw["bvh"]) {
         const YAML::Mark at = raw["source"] ? raw["source"].Mark() : raw.Mark();
         throw core::ConfigError(
-            fmt::format("{}:{}: field 'source': mannequin-simulate plays BVH captures (source: bvh with a bvh section)",
+            fmt::format("{}:{}: field 'source': mannequin-simulate plays BVH captures (source: bvh with a bvh section) "
+                        "and scripted ones (source: synthetic with a duration)",
                         mocap_path, at.line + 1));
       }
-      if (!options.mocap.empty()) raw["bvh"]["file"] = options.mocap;
-      raw["bvh"]["loop"] = false;   // the capture once
-      raw["bvh"]["paced"] = false;  // as fast as asked for
-      capture_file_ = raw["bvh"]["file"].as<std::string>("");
-      source_ = mocap::makeSource(core::ConfigNode(raw, mocap_path));
-      if (const auto* b = dynamic_cast<const mocap::BvhSource*>(source_.get()))
-        capture_length_s_ = b->bvh().num_frames * b->bvh().frame_time / raw["bvh"]["rate"].as<double>(1.0);
+      if (!scripted) {
+        if (!options.mocap.empty()) raw["bvh"]["file"] = options.mocap;
+        raw["bvh"]["loop"] = false;   // the capture once
+        raw["bvh"]["paced"] = false;  // as fast as asked for
+        capture_file_ = raw["bvh"]["file"].as<std::string>("");
+        source_ = mocap::makeSource(core::ConfigNode(raw, mocap_path));
+        if (const auto* b = dynamic_cast<const mocap::BvhSource*>(source_.get()))
+          capture_length_s_ = b->bvh().num_frames * b->bvh().frame_time / raw["bvh"]["rate"].as<double>(1.0);
+      }
     }
     world_ = std::make_unique<sim::World>(buildMannequins(c), c.world);
   } catch (const OfflineInputError&) {
@@ -201,6 +220,7 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
   const SimServiceConfig& config = config_;
   OfflineSummary s;
   s.physics = world.physics();
+  s.balance_controller = world.physics() && world.config().physics.balance_controller.enabled;
   for (int m = 0; m < world.numMannequins(); ++m) s.ergonomics.push_back({world.name(m)});
 
   std::unique_ptr<recording::McapWriter> writer;
@@ -302,6 +322,11 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
     throw;
   }
   s.wall_s = wall();
+  if (world.physics())
+    for (int m = 0; m < world.numMannequins(); ++m) {
+      s.balance_solves += world.mannequinDiagnostics(m).balance_solves;
+      s.balance_failures += world.mannequinDiagnostics(m).balance_failures;
+    }
   progress.done();
   s.sim_time_s = world.time();
   if (const constraints::ConstraintSolver* cs = world.constraintSolver()) s.lcp_failures = cs->failures();

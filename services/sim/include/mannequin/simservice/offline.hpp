@@ -47,6 +47,11 @@ struct OfflineSummary {
   double force_margin_sum = 0;
   long long force_margin_samples = 0;
   double worst_joint_limit_excess_rad = 0;
+  // the balance controller (physics.balance_controller): solves and failed updates (all mannequins, at the
+  // end), mannequin-steps it drove, and of those the ones with the whole margin asked for held
+  bool balance_controller = false;
+  long long balance_solves = 0, balance_failures = 0;
+  long long balance_driving_steps = 0, balance_full_margin_steps = 0, mannequin_steps = 0;
   double hand_error_sum = 0, foot_error_sum = 0;
   long long hand_samples = 0, foot_samples = 0;
   bool physics = false;
@@ -59,6 +64,12 @@ struct OfflineSummary {
   double meanHandError() const { return hand_samples > 0 ? hand_error_sum / static_cast<double>(hand_samples) : kNaN; }
   double meanFootError() const { return foot_samples > 0 ? foot_error_sum / static_cast<double>(foot_samples) : kNaN; }
   double realtimeFactor() const { return wall_s > 0 ? sim_time_s / wall_s : kNaN; }
+  double balanceDrivingFraction() const {
+    return mannequin_steps > 0 ? static_cast<double>(balance_driving_steps) / static_cast<double>(mannequin_steps) : kNaN;
+  }
+  double balanceFullMarginFraction() const {
+    return balance_driving_steps > 0 ? static_cast<double>(balance_full_margin_steps) / static_cast<double>(balance_driving_steps) : kNaN;
+  }
   double meanForceMargin() const {
     return force_margin_samples > 0 ? force_margin_sum / static_cast<double>(force_margin_samples) : kNaN;
   }
