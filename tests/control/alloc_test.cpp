@@ -1,5 +1,6 @@
 // The control step allocates nothing after construction: the three stages with a constraint force,
-// two priority levels, the internal control and an enabled virtual mechanism. malloc is
+// two priority levels, the internal control, an enabled virtual mechanism and the joint coupling
+// (set again inside the loop). malloc is
 // interposed, so this runs only without AddressSanitizer (which owns malloc). With
 // -DMANNEQUIN_CHECK_RUNTIME_MALLOC=ON the loop also runs under NoEigenMalloc: an Eigen allocation
 // asserts at the line that makes it.
@@ -34,6 +35,11 @@ TEST(ControlAlloc, StepAllocatesNothing) {
     VectorX gamma_c = VectorX::Zero(ctl.model().nv);
     gamma_c(2) = 10.0;
     SE3 target = ctl.frame(ctl.frameIndex("hand_l")).pose;
+    // the joint coupling on (sim::World sets it again every balance period)
+    VectorX q_j = ctl.q();
+    q_j.tail(ctl.model().nq - 6).array() += 0.05;
+    const VectorX k_j = VectorX::Constant(ctl.model().nv, 50.0), b_j = VectorX::Constant(ctl.model().nv, 0.5);
+    ctl.setJointCoupling(q_j, k_j, b_j);
     ctl.step();  // warm-up
     const long allocations = countAllocations([&] {
       const NoEigenMalloc no_eigen_malloc;
@@ -43,10 +49,12 @@ TEST(ControlAlloc, StepAllocatesNothing) {
         ctl.computeFreeMotion();
         ctl.applyConstraintForce(gamma_c);
         ctl.integrate();
+        ctl.setJointCoupling(q_j, k_j, b_j);
         ctl.step();
       }
     });
     EXPECT_EQ(allocations, 0) << toString(method);
+    EXPECT_GT(ctl.jointCouplingTorque().cwiseAbs().maxCoeff(), 0.0) << "the coupling was on";
   }
 #endif
 }

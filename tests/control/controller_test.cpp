@@ -347,3 +347,217 @@ TEST(Controller, CouplingErrorFormsAgreeToFirstOrderAndBothReach) {
   ctl.computeFreeMotion();
   EXPECT_LT(ctl.frame(h).error.norm(), 1e-6);
 }
+
+//---- joint coupling (thesis 4.4.2): Γ_j = k∘(q_j ⊖ q) − b∘q̇_prev, added to Γ unprojected ----
+
+namespace {
+Matrix3 rotationOf(const Vector3& v) {  // exp of a rotation vector, by Eigen (not the library's expSO3)
+  return v.norm() == 0 ? Matrix3::Identity() : Eigen::AngleAxisd(v.norm(), v.normalized()).toRotationMatrix();
+}
+Vector3 rotationVector(const Matrix3& R) {  // log, by Eigen
+  const Eigen::AngleAxisd aa(R);
+  return aa.angle() * aa.axis();
+}
+int firstJoint(const skeleton::Model& m, skeleton::JointType type) {
+  for (std::size_t j = 0; j < m.joints.size(); ++j)
+    if (m.joints[j].type == type) return static_cast<int>(j);
+  ADD_FAILURE() << "no joint of type " << skeleton::toString(type);
+  return 0;
+}
+/// The scalar recurrence of one coordinate under the coupling alone (b = b_a diagonal, r = k δt/b_a,
+/// ρ = b_j/b_a): u_n = r x_n − ρ u_{n−1} (u = q̇ δt), x_{n+1} = x_n − u_n, from x_0 = 1, u_{−1} = 0.
+/// Returns x_N and Σ_{n<N} u_n².
+std::pair<double, double> couplingRecurrence(double r, double rho, int steps) {
+  double x = 1, u = 0, sum_u2 = 0;
+  for (int n = 0; n < steps; ++n) {
+    u = r * x - rho * u;
+    x -= u;
+    sum_u2 += u * u;
+  }
+  return {x, sum_u2};
+}
+}  // namespace
+
+TEST(Controller, JointCouplingTorqueIsTheSpringDamperOnTheManifoldAddedUnprojected) {
+  // default config: 6 frames on two levels, projected posture control, gravity. The coupling's torque
+  // is Γ_j = k∘(q_j ⊖ q) − b∘q̇_prev on every coordinate and enters q̇_free = b⁻¹(Γ_task + Γ_int + Γ_g + Γ_j)
+  // as it is (no projection, no α).
+  const auto& model = male50();
+  ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+  Controller ctl(model, c);
+  const int nv = model.nv;
+  const VectorX q0 = ctl.q();
+  EXPECT_FALSE(ctl.jointCoupling());
+  const int ball = firstJoint(model, skeleton::JointType::kBall);
+  const int rev = firstJoint(model, skeleton::JointType::kRevolute);
+  const int iq_b = model.joints[ball].idx_q, iv_b = model.joints[ball].idx_v;
+  VectorX q_j = q0;
+  q_j.head<3>() += Vector3(0.02, -0.01, 0.03);                                                 // root translation
+  q_j.segment<3>(iq_b) = rotationVector(rotationOf(q0.segment<3>(iq_b)) * rotationOf(Vector3(0.2, -0.3, 0.25)));
+  q_j(model.joints[rev].idx_q) += 0.15;
+  VectorX k(nv), b(nv);
+  for (int i = 0; i < nv; ++i) {
+    k(i) = 20.0 + i;
+    b(i) = 0.3 + 0.01 * i;
+  }
+  ctl.setJointCoupling(q_j, k, b);
+  EXPECT_TRUE(ctl.jointCoupling());
+
+  // step 1 from rest (q̇_prev = 0): Γ_j = k∘(q_j ⊖ q0); the ball's part is the rotation vector of
+  // R(q0)ᵀ R(q_j) = the offset (0.2, −0.3, 0.25) put on it
+  ASSERT_EQ(ctl.computeFreeMotion(), StepStatus::kOk);
+  VectorX expected = k.cwiseProduct(skeleton::difference(model, q0, q_j));
+  EXPECT_LT((ctl.jointCouplingTorque() - expected).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_LT((ctl.jointCouplingTorque().segment<3>(iv_b) - k.segment<3>(iv_b).cwiseProduct(Vector3(0.2, -0.3, 0.25))).norm(), 1e-12);
+  EXPECT_NEAR(ctl.jointCouplingTorque()(model.joints[rev].idx_v), 0.15 * k(model.joints[rev].idx_v), 1e-12);
+  ctl.integrate();
+
+  // step 2: the ball's difference by hand (Eigen's angle-axis), the damping on the last step's q̇
+  const VectorX q1 = ctl.q(), v1 = ctl.qdot();
+  ASSERT_GT(v1.cwiseAbs().maxCoeff(), 0.0);
+  ASSERT_EQ(ctl.computeFreeMotion(), StepStatus::kOk);
+  expected = k.cwiseProduct(skeleton::difference(model, q1, q_j)) - b.cwiseProduct(v1);
+  const Vector3 e_ball = rotationVector(rotationOf(q1.segment<3>(iq_b)).transpose() * rotationOf(q_j.segment<3>(iq_b)));
+  EXPECT_LT((expected.segment<3>(iv_b) -
+             (k.segment<3>(iv_b).cwiseProduct(e_ball) - b.segment<3>(iv_b).cwiseProduct(v1.segment<3>(iv_b)))).norm(), 1e-12);
+  const double scale = expected.cwiseAbs().maxCoeff();
+  EXPECT_LT((ctl.jointCouplingTorque() - expected).cwiseAbs().maxCoeff(), 1e-12 * scale);
+  // unprojected: b q̇_free = the plain sum
+  const VectorX sum = ctl.taskTorque() + ctl.internalTorque() + ctl.gravityTorque() + ctl.jointCouplingTorque();
+  const VectorX qdot_free = ctl.apparentFriction().ldlt().solve(sum);
+  EXPECT_LT((ctl.qdotFree() - qdot_free).norm() / qdot_free.norm(), 1e-10);
+  ctl.integrate();
+  EXPECT_GT(std::abs(ctl.jointCouplingPort().energy), 0.0);
+}
+
+TEST(Controller, JointCouplingAloneConvergesToQjAndItsPortBalancesTheDissipation) {
+  // The coupling alone (no frames, no gravity, no internal control): b = b_a and q̇ = b_a⁻¹Γ_j. With
+  // k = r b_a/δt on every coordinate, q̇ δt is along (q_j ⊖ q) joint by joint, and q ⊕ q̇δt moves every
+  // joint — revolute, ball (R exp(u)) and the free-flying root (H exp(V)) — along the one-parameter
+  // subgroup towards q_j: e = q_j ⊖ q obeys the scalar recurrence of couplingRecurrence() exactly.
+  // The port's power Γ_jᵀq̇ is q̇ᵀb_a q̇, the dissipation's, and its energy Σ b_a q̇² δt = (2U_0/r) Σ u_n²,
+  // U_0 = ½ Σ k e_0²; without damping that is U_0 (1 − (1−r)^{2N}) / (1 − r/2): at most U_0/(1 − r/2), the
+  // explicit step's overshoot of the stored energy.
+  const auto& model = male50();
+  ControllerConfig c = baseConfig();
+  c.internal.enabled = false;
+  const double r = 0.1;
+  const int steps = 300;
+  for (double rho : {0.0, 0.5}) {
+    Controller ctl(model, c);
+    const VectorX q0 = ctl.q();
+    std::mt19937 rng(7);
+    std::uniform_real_distribution<double> u(-0.3, 0.3);
+    VectorX offset(model.nv);
+    for (int i = 0; i < model.nv; ++i) offset(i) = u(rng);
+    const VectorX q_j = skeleton::integrate(model, q0, offset);
+    const VectorX& b_a = ctl.frictionDiagonal();
+    const VectorX k = (r / c.dt) * b_a, b = rho * b_a;
+    ctl.setJointCoupling(q_j, k, b);
+    const VectorX e0 = skeleton::difference(model, q0, q_j);
+    const double U0 = 0.5 * e0.cwiseProduct(e0).dot(k);
+    for (int n = 0; n < steps; ++n) ASSERT_EQ(ctl.step(), StepStatus::kOk);
+    const auto [x_n, sum_u2] = couplingRecurrence(r, rho, steps);
+    const VectorX e = skeleton::difference(model, ctl.q(), q_j);
+    EXPECT_LT(std::abs(x_n), 1e-6) << "rho " << rho;  // the recurrence itself converges (|λ| < 1)
+    EXPECT_LT((e - x_n * e0).cwiseAbs().maxCoeff(), 1e-9 * e0.cwiseAbs().maxCoeff()) << "rho " << rho;
+    EXPECT_LT(e.cwiseAbs().maxCoeff(), 1e-6 * e0.cwiseAbs().maxCoeff()) << "q reaches q_j, rho " << rho;
+    const double W = ctl.jointCouplingPort().energy;
+    EXPECT_NEAR(W, ctl.dissipation().energy, 1e-9 * W) << "rho " << rho;
+    EXPECT_NEAR(W, 2 * U0 / r * sum_u2, 1e-9 * W) << "rho " << rho;
+    if (rho == 0) {
+      EXPECT_NEAR(W, U0 * (1 - std::pow(1 - r, 2 * steps)) / (1 - r / 2), 1e-9 * W);
+      EXPECT_LE(W, U0 / (1 - r / 2));
+    }
+    EXPECT_EQ(ctl.internalPort().energy, 0.0);
+  }
+}
+
+TEST(Controller, JointCouplingBadInputIsRejectedNamedAndTheCouplingKept) {
+  const auto& model = male50();
+  ControllerConfig c = baseConfig();
+  c.internal.enabled = false;
+  Controller a(model, c), twin(model, c);
+  const int nv = model.nv, nq = model.nq;
+  const VectorX k = VectorX::Constant(nv, 30.0), b = VectorX::Constant(nv, 0.2);
+  VectorX q_j = a.q();
+  q_j.tail(nq - 6).array() += 0.1;
+  // not set yet: a bad call leaves it off
+  EXPECT_THROW(a.setJointCoupling(q_j, VectorX::Constant(nv, -1.0), b), std::invalid_argument);
+  EXPECT_FALSE(a.jointCoupling());
+  a.setJointCoupling(q_j, k, b);
+  twin.setJointCoupling(q_j, k, b);
+  const VectorX q_start = a.q();
+  const auto expectRejected = [&](const VectorX& qq, const VectorX& kk, const VectorX& bb, const std::vector<std::string>& words) {
+    try {
+      a.setJointCoupling(qq, kk, bb);
+      ADD_FAILURE() << "accepted; expected an error naming " << words.front();
+    } catch (const std::invalid_argument& e) {
+      for (const std::string& w : words) EXPECT_NE(std::string(e.what()).find(w), std::string::npos) << e.what();
+    }
+    EXPECT_TRUE(a.jointCoupling());
+  };
+  expectRejected(q_j.head(nq - 1), k, b, {"sizes", std::to_string(nq - 1)});
+  expectRejected(q_j, VectorX::Constant(nv + 1, 1.0), b, {"sizes", std::to_string(nv + 1)});
+  expectRejected(q_j, k, VectorX(), {"sizes"});
+  const auto names = model.coordinateNames();
+  VectorX bad = q_j;
+  bad(9) = std::nan("");
+  expectRejected(bad, k, b, {"q_j(9", names[9], "not finite"});
+  bad = k;
+  bad(12) = std::numeric_limits<double>::infinity();
+  expectRejected(q_j, bad, b, {"stiffness(12", names[12], "not finite"});
+  bad = b;
+  bad(3) = std::nan("");
+  expectRejected(q_j, k, bad, {"damping(3", "not finite"});
+  bad = k;
+  bad(20) = -5;
+  expectRejected(q_j, bad, b, {"stiffness(20", names[20], "negative"});
+  bad = b;
+  bad(nv - 1) = -1e-3;
+  expectRejected(q_j, k, bad, {"damping(" + std::to_string(nv - 1), "negative"});
+  // the coupling in place is the good one: same motion as the twin that never saw the bad calls
+  for (int i = 0; i < 50; ++i) {
+    ASSERT_EQ(a.step(), StepStatus::kOk);
+    twin.step();
+  }
+  EXPECT_GT((a.q() - q_start).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((a.q() - twin.q()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_EQ((a.jointCouplingTorque() - twin.jointCouplingTorque()).cwiseAbs().maxCoeff(), 0.0);
+  EXPECT_GT(a.jointCouplingTorque().cwiseAbs().maxCoeff(), 0.0);
+}
+
+TEST(Controller, JointCouplingIsClearedByClearAndByReset) {
+  // coupling alone (no frames, gravity or internal control): once cleared nothing moves the mannequin
+  const auto& model = male50();
+  ControllerConfig c = baseConfig();
+  c.internal.enabled = false;
+  Controller ctl(model, c);
+  const VectorX q0 = ctl.q();
+  VectorX q_j = q0;
+  q_j.tail(model.nq - 6).array() += 0.1;
+  const VectorX k = VectorX::Constant(model.nv, 30.0), b = VectorX::Constant(model.nv, 0.2);
+  for (bool by_reset : {false, true}) {
+    ctl.setJointCoupling(q_j, k, b);
+    for (int i = 0; i < 20; ++i) ASSERT_EQ(ctl.step(), StepStatus::kOk);
+    ASSERT_GT(ctl.jointCouplingTorque().cwiseAbs().maxCoeff(), 0.0);
+    ASSERT_GT(ctl.jointCouplingPort().energy, 0.0);
+    if (by_reset) {
+      ctl.reset(q0);
+      EXPECT_EQ(ctl.jointCouplingPort().energy, 0.0) << "reset() restarts the port like the others";
+    } else {
+      ctl.clearJointCoupling();
+    }
+    EXPECT_FALSE(ctl.jointCoupling());
+    EXPECT_EQ(ctl.jointCouplingTorque().cwiseAbs().maxCoeff(), 0.0);
+    const VectorX before = ctl.q();
+    const double port = ctl.jointCouplingPort().energy;
+    for (int i = 0; i < 20; ++i) ASSERT_EQ(ctl.step(), StepStatus::kOk);
+    EXPECT_EQ(ctl.jointCouplingTorque().cwiseAbs().maxCoeff(), 0.0) << (by_reset ? "reset" : "clear");
+    EXPECT_EQ(ctl.jointCouplingPort().energy, port);
+    // no torque at all: q̇ = 0 (the last q̇ only enters through the coupling's damping); q ⊕ 0 = q to
+    // rounding (the root's rotation goes through exp/log)
+    EXPECT_EQ(ctl.qdot().cwiseAbs().maxCoeff(), 0.0) << (by_reset ? "reset" : "clear");
+    EXPECT_LT((ctl.q() - before).cwiseAbs().maxCoeff(), 1e-15) << (by_reset ? "reset" : "clear");
+  }
+}

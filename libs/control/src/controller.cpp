@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "mannequin/skeleton/anthropometry.hpp"
 
@@ -224,6 +225,7 @@ void Controller::reset(const VectorX& q0) {
   port_internal_.reset();
   port_gravity_.reset();
   port_constraint_.reset();
+  port_joint_.reset();
   dissipated_.reset();
   have_internal_power_ = false;
   potential_ = 0;
@@ -303,10 +305,20 @@ void Controller::setJointCoupling(const VectorX& q_j, const VectorX& stiffness, 
     throw std::invalid_argument("setJointCoupling: sizes " + std::to_string(q_j.size()) + ", " + std::to_string(stiffness.size()) +
                                 ", " + std::to_string(damping.size()) + ", expected " + std::to_string(model_.nq) + ", " +
                                 std::to_string(nv_) + ", " + std::to_string(nv_));
-  if (!q_j.allFinite() || !stiffness.allFinite() || !damping.allFinite())
-    throw std::invalid_argument("setJointCoupling: non-finite values (coupling kept)");
-  if ((stiffness.array() < 0).any() || (damping.array() < 0).any())
-    throw std::invalid_argument("setJointCoupling: negative stiffness or damping (coupling kept)");
+  // name the argument and the coordinate (ball and free-flyer q entries share their joint's names)
+  const auto coordinate = [&](Eigen::Index k) {
+    const std::vector<std::string> names = model_.coordinateNames();
+    return std::to_string(k) + (k < static_cast<Eigen::Index>(names.size()) ? " ('" + names[static_cast<std::size_t>(k)] + "')" : "");
+  };
+  for (const auto& [what, v] : {std::pair<const char*, const VectorX*>{"q_j", &q_j}, {"stiffness", &stiffness}, {"damping", &damping}})
+    for (Eigen::Index k = 0; k < v->size(); ++k)
+      if (!std::isfinite((*v)(k)))
+        throw std::invalid_argument(std::string("setJointCoupling: ") + what + "(" + coordinate(k) + ") is not finite (coupling kept)");
+  for (const auto& [what, v] : {std::pair<const char*, const VectorX*>{"stiffness", &stiffness}, {"damping", &damping}})
+    for (Eigen::Index k = 0; k < v->size(); ++k)
+      if ((*v)(k) < 0)
+        throw std::invalid_argument(std::string("setJointCoupling: ") + what + "(" + coordinate(k) + ") = " + std::to_string((*v)(k)) +
+                                    " is negative (coupling kept)");
   q_j_ = q_j;
   k_j_ = stiffness;
   b_j_ = damping;

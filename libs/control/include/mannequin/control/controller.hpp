@@ -140,7 +140,9 @@ class Controller {
   /// Γ_j = k_j∘(q_j ⊖ q) − b_j∘q̇_prev on every coordinate, NOT projected and without the observer's α:
   /// a spring-damper per coordinate towards q_j, added to Γ at each step until clearJointCoupling().
   /// The balance controller in the loop (sim::World) drives the mannequin to its q ⊕ δq with it.
-  /// \throws std::invalid_argument on sizes (nq, nv, nv), non-finite values or negative gains; state kept.
+  /// reset() clears it (and its port).
+  /// \throws std::invalid_argument on sizes (nq, nv, nv), a non-finite value or a negative gain (the message
+  /// names the argument and the coordinate); the previous coupling is kept.
   void setJointCoupling(const VectorX& q_j, const VectorX& stiffness, const VectorX& damping);
   void clearJointCoupling();
   bool jointCoupling() const { return joint_coupling_; }
