@@ -275,3 +275,151 @@ TEST(VariationalBalance, BadProblemsAreNamed) {
   b.max_step = 0;
   expect(b, q, "max_step");
 }
+
+namespace {
+/// Standing on both soles (4 points each), held where they are.
+VariationalBalanceProblem standing(const skeleton::VectorX& q) {
+  const skeleton::Model& m = male50();
+  skeleton::Data d(m);
+  skeleton::forwardKinematics(m, d, q);
+  VariationalBalanceProblem p;
+  p.contacts = soleContacts(m);
+  p.held = holdCurrentPoses(p.contacts, d.oMi);
+  return p;
+}
+
+/// The static problem of the same contacts (world points at q) with the weight at `com` (fix_com: the
+/// margins on G_f⁺, what forceMargin measures).
+StaticBalanceProblem staticAt(const VariationalBalanceProblem& p, const skeleton::VectorX& q, const math::Vector3& com) {
+  const skeleton::Model& m = male50();
+  skeleton::Data d(m);
+  skeleton::forwardKinematics(m, d, q);
+  StaticBalanceProblem s;
+  for (const BodyContact& c : p.contacts)
+    s.contacts.push_back({d.oMi[static_cast<std::size_t>(c.joint)].act(c.local_point), c.normal, c.mu, c.desired_force});
+  s.mass = m.totalMass();
+  s.gravity = p.gravity;
+  s.edges = p.edges;
+  s.fix_com = true;
+  s.desired_com = com;
+  return s;
+}
+}  // namespace
+
+// Internal control (thesis 4.1): the criterion ‖δq − δq_d‖²_{w_q} instead of ‖δq‖²_{w_q}. With the same
+// feasible set and the same other terms φ, the optima δq_1 (with δq_d) and δq_0 (without) satisfy
+//   φ(δq_1) + ½w‖δq_1 − δq_d‖² ≤ φ(δq_0) + ½w‖δq_0 − δq_d‖²  and  φ(δq_0) + ½w‖δq_0‖² ≤ φ(δq_1) + ½w‖δq_1‖²,
+// whose sum is (δq_1 − δq_0)·δq_d ≥ 0: the step moves towards δq_d. On the right elbow (free: no contact,
+// no task; it only moves the CoM, by ~1 cm/rad, which the forces follow at ~10² N/rad, a curvature of
+// ~10⁴ against w_q = 10⁶) the step is nearly all of δq_d.
+TEST(VariationalBalance, DqDesiredPullsTheStepTowardsIt) {
+  const skeleton::Model& m = male50();
+  const skeleton::VectorX q = skeleton::standingConfiguration(m);
+  const int elbow = testing_fixture::coordinate("elbow_r");
+  VariationalBalanceSolver solver(m);
+  VariationalBalanceProblem p = standing(q);
+  ASSERT_EQ(solver.solve(p, q).status, BalanceStatus::kSolved) << solver.result().message;
+  const skeleton::VectorX dq0 = solver.result().dq;
+  const double d = 0.01;  // rad, inside max_step and the elbow's range (0–150°) from q
+  ASSERT_LE(q[elbow] + d, m.upper_limit[elbow]);
+  ASSERT_GE(q[elbow] + d, m.lower_limit[elbow]);
+  p.dq_desired = skeleton::VectorX::Zero(m.nv);
+  p.dq_desired[elbow] = d;
+  ASSERT_EQ(solver.solve(p, q).status, BalanceStatus::kSolved) << solver.result().message;
+  const skeleton::VectorX dq1 = solver.result().dq;
+  std::printf("dq_desired %.4f on elbow_r: step %.6f without, %.6f with\n", d, dq0[elbow], dq1[elbow]);
+  EXPECT_GE((dq1 - dq0).dot(p.dq_desired), -1e-12);
+  EXPECT_LT(std::abs(dq1[elbow] - d), std::abs(dq0[elbow] - d));
+  EXPECT_GT(dq1[elbow] - dq0[elbow], 0.9 * d);
+  EXPECT_LT(solver.result().equilibrium_residual, 1e-6);
+  // a zero δq_d is the thesis's (3.107): the same step as none
+  p.dq_desired.setZero();
+  ASSERT_EQ(solver.solve(p, q).status, BalanceStatus::kSolved);
+  EXPECT_LT((solver.result().dq - dq0).cwiseAbs().maxCoeff(), 1e-12);
+
+  // bad sizes and values: kInvalid naming dq_desired, no throw
+  for (int size : {m.nv - 1, m.nv + 6, 1}) {
+    p.dq_desired = skeleton::VectorX::Zero(size);
+    VariationalBalanceResult r;
+    EXPECT_NO_THROW(r = solver.solve(p, q)) << size;
+    EXPECT_EQ(r.status, BalanceStatus::kInvalid) << size;
+    EXPECT_NE(r.message.find("dq_desired"), std::string::npos) << r.message;
+  }
+  p.dq_desired = skeleton::VectorX::Zero(m.nv);
+  p.dq_desired[elbow] = std::nan("");
+  EXPECT_EQ(solver.solve(p, q).status, BalanceStatus::kInvalid);
+  EXPECT_NE(solver.result().message.find("dq_desired"), std::string::npos) << solver.result().message;
+}
+
+// margins_at_com: the edge reserves come from G_f⁺ (the CoM given), so every push D_i is balanced by
+// non-negative edge forces at the step's own linearised CoM: the static problem of the same contacts with
+// the weight at result.com (fix_com, the margins on G_f⁺ as forceMargin takes them) is solvable with those
+// pushes, and forceMargin there is at least the push asked for. Two cases: (a) a forward push of 95 % of
+// the standing posture's margin, no task; (b) fore-aft pushes of 90 % of it while the right hand reaches
+// forwards and down (the CoM moves ~7 cm). The thesis form (margins_at_com off) is run alongside and its
+// margin at its own linearised CoM printed: in (a) it is below the push asked for (the part of the push's
+// moment its G⁺ gives to a CoM shift the step does not make), which is what this option is for.
+TEST(VariationalBalance, MarginsAtComHoldEachPushAtTheLinearisedCom) {
+  const skeleton::Model& m = male50();
+  const skeleton::VectorX q0 = skeleton::standingConfiguration(m);
+  const math::Vector3 at = comOf(q0);
+  const double tol = 0.25;  // N, forceMargin's bisection
+  struct Case {
+    const char* name;
+    std::vector<math::Vector3> dirs;
+    double fraction;
+    bool reach;
+    int steps;
+  };
+  for (const Case& c : {Case{"forward push, standing", {math::Vector3::UnitX()}, 0.95, false, 5},
+                        Case{"fore-aft pushes, reaching", {math::Vector3::UnitX(), -math::Vector3::UnitX()}, 0.9, true, 40}}) {
+    SCOPED_TRACE(c.name);
+    skeleton::VectorX q = q0;
+    VariationalBalanceProblem p = standing(q);
+    StaticBalanceSolver stat;
+    const ForceMarginResult m0 = forceMargin(stat, staticAt(p, q, at), c.dirs, at, 2000.0, tol);
+    ASSERT_EQ(m0.status, BalanceStatus::kSolved) << m0.message;
+    ASSERT_GT(m0.margin_n, 10.0);
+    const double F = c.fraction * m0.margin_n;
+    for (const math::Vector3& d : c.dirs) {
+      math::Vector6 D;
+      D << at.cross(F * d), F * d;
+      p.force_margins.push_back(D);
+    }
+    p.margins_at_com = true;
+    const math::Vector3 reach = framePosition(q, "hand_r") + math::Vector3(0.25, -0.05, 0.10);
+    if (c.reach) p.tasks = {{m.frameIndex("hand_r"), reach}};
+    VariationalBalanceSolver solver(m), thesis(m);
+    double worst = 2000.0, worst_thesis = 2000.0;
+    for (int step = 0; step < c.steps; ++step) {
+      const VariationalBalanceResult& r = solver.solve(p, q);
+      ASSERT_EQ(r.status, BalanceStatus::kSolved) << "step " << step << ": " << r.message;
+      StaticBalanceProblem s = staticAt(p, q, r.com);
+      s.force_margins = p.force_margins;
+      EXPECT_EQ(stat.solve(s).status, BalanceStatus::kSolved) << "step " << step << ": " << stat.result().message;
+      const double fm = forceMargin(stat, staticAt(p, q, r.com), c.dirs, at, 2000.0, tol).margin_n;
+      EXPECT_GE(fm, F - tol) << "step " << step;
+      worst = std::min(worst, fm);
+      VariationalBalanceProblem t = p;
+      t.margins_at_com = false;
+      const VariationalBalanceResult& rt = thesis.solve(t, q);
+      if (rt.status == BalanceStatus::kSolved)
+        worst_thesis = std::min(worst_thesis, forceMargin(stat, staticAt(p, q, rt.com), c.dirs, at, 2000.0, tol).margin_n);
+      q = skeleton::integrate(m, q, r.dq);
+    }
+    std::printf("%s: push %.1f N (standing margin %.1f N); CoM x %.4f -> %.4f m; margin at the linearised CoM down to "
+                "%.1f N (margins_at_com), %.1f N (thesis form)\n",
+                c.name, F, m0.margin_n, at.x(), comOf(q).x(), worst, worst_thesis);
+    if (c.reach) {
+      EXPECT_LT((framePosition(q, "hand_r") - reach).norm(), 0.01) << "the hand reaches";
+      EXPECT_GT(comOf(q).x() - at.x(), 0.02) << "and the CoM moves with it";
+    }
+
+    // com_margins with margins_at_com: kInvalid, named
+    p.com_margins = {math::Vector3(0.01, 0, 0)};
+    EXPECT_EQ(solver.solve(p, q).status, BalanceStatus::kInvalid);
+    EXPECT_NE(solver.result().message.find("com_margins"), std::string::npos) << solver.result().message;
+    p.margins_at_com = false;
+    EXPECT_EQ(solver.solve(p, q).status, BalanceStatus::kSolved) << solver.result().message;
+  }
+}
