@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <memory>
 #include <thread>
 
@@ -178,6 +179,7 @@ namespace {
 struct MocapFeed {
   std::string name;
   std::vector<v1::MocapFrame> frames;
+  std::vector<std::pair<std::size_t, v1::Trigger>> triggers = {};  // (k, trigger): published just before frame k
 };
 
 // Runs a replay-mode sim service in-process with `cfg` (publish/connect set here), one publisher per
@@ -188,7 +190,7 @@ struct MocapFeed {
 // (several sockets) reach the sim in whatever order the sockets deliver them: all of one feed's first,
 // possibly, and then the other source's mannequin waits uncalibrated while the first one's actor moves.
 std::vector<std::string> replayRun(simservice::SimServiceConfig cfg, const std::vector<MocapFeed>& feeds, const std::string& dir,
-                                   bool lockstep = false) {
+                                   bool lockstep = false, std::vector<std::string>* scenario_states = nullptr) {
   zmq::context_t ctx;
   const std::string sim_ep = "ipc://" + dir + "/sim";
   // the recorded input is byte-identical between runs: no wall-clock send time in it either
@@ -208,6 +210,10 @@ std::vector<std::string> replayRun(simservice::SimServiceConfig cfg, const std::
   out.subscribeRaw("sim.world", [&](std::string_view, std::string_view payload, const transport::Received&) {
     worlds.emplace_back(payload);
   });
+  if (scenario_states != nullptr)
+    out.subscribeRaw("scenario.state", [&](std::string_view, std::string_view payload, const transport::Received&) {
+      scenario_states->emplace_back(payload);
+    });
   std::atomic<bool> stop{false};
   std::thread runner([&] { sim.run(stop); });
   // Every wait has a deadline and fails naming what it waited for; the sim is stopped in every case.
@@ -250,6 +256,11 @@ std::vector<std::string> replayRun(simservice::SimServiceConfig cfg, const std::
       bool any = false;
       for (std::size_t i = 0; i < feeds.size(); ++i)
         if (k < feeds[i].frames.size()) {
+          for (const auto& [at, trigger] : feeds[i].triggers)
+            if (at == k) {
+              v1::Trigger t = trigger;
+              mocap[i]->publish(transport::topics::kScenarioTrigger, t);
+            }
           v1::MocapFrame f = feeds[i].frames[k];  // publish() fills the header
           mocap[i]->publish(transport::topics::kMocapFrame, f);
           ++sent;
@@ -435,4 +446,82 @@ TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {
   EXPECT_LT(w.mocap_sources(0).stamp_ns(), 1'000'000'000);
   EXPECT_GE(w.mocap_sources(1).stamp_ns(), clock_b);
   EXPECT_EQ(w.mocap().source(), "mocap_a");  // no frame of the default source: the first named one's
+}
+
+// The sim service runs its config's scenario (key `scenario`) in the loop: an operator trigger from the
+// network (scenario.trigger, on a publisher the sim connects to) switches the right hand from the capture
+// to an autonomous reach; sim.world reports each control frame's mode; scenario.state reports the state.
+TEST(SimService, ATriggerOnTheNetworkSwitchesTheScenarioAndTheWorldReportsTheModes) {
+  const std::string dir = tempDir();
+  const std::string sc_path = dir + "/reach.yaml";
+  {
+    std::ofstream f(sc_path);
+    f << "scenario: reach\nmannequins:\n  - {name: operator, frames: [hand_r]}\ntriggers: [go]\ninitial: follow\n"
+         "states:\n  - name: follow\n    transitions: [{to: reach, name: operator says go, when: {trigger: go}}]\n"
+         "  - name: reach\n    modes:\n      hand_r: {mode: autonomous, goal: {xyz: [0.5, -0.3, 1.2], rpy_deg: [0, 0, 0]}, duration_s: 0.05}\n";
+  }
+  simservice::SimServiceConfig cfg = simservice::parseSimConfig(core::ConfigNode::parse(
+      "mannequins:\n  - {name: operator, config: configs/mannequins/male_50th.yaml, control_frames: {pelvis: pelvis, head: head, "
+      "hand_l: hand_l, hand_r: hand_r, foot_l: foot_l, foot_r: foot_r}}\nworld_rate: 120\nscenario: {file: " + sc_path +
+      ", state_rate: 100}\n", "sim.yaml"));
+  EXPECT_EQ(cfg.scenario.scenario.name, "reach");
+  MocapFeed feed{"mocap", {}, {}};
+  for (int k = 0; k < 40; ++k) feed.frames.push_back(actorFrame(k));
+  v1::Trigger go;
+  go.set_name("go");
+  v1::Trigger typo;
+  typo.set_name("og");  // not declared: logged, ignored
+  feed.triggers = {{10, typo}, {20, go}};
+  std::vector<std::string> states;
+  const auto worlds = replayRun(cfg, {feed}, dir, true, &states);
+  ASSERT_FALSE(worlds.empty());
+  // the right hand's mode: free until the trigger's frame (k = 20 → 0.167 s), autonomous after
+  double first_autonomous = -1, last_free = -1;
+  for (const std::string& p : worlds) {
+    v1::WorldState w;
+    ASSERT_TRUE(w.ParseFromString(p));
+    for (const v1::ControlFrameState& c : w.mannequins(0).control_frames()) {
+      if (c.frame() == "hand_r" && c.mode() == "autonomous" && first_autonomous < 0) first_autonomous = w.sim_time();
+      if (c.frame() == "hand_r" && c.mode() == "free") last_free = w.sim_time();
+      if (c.frame() != "hand_r") {
+        EXPECT_EQ(c.mode(), "free") << c.frame();
+      }
+    }
+  }
+  EXPECT_GT(first_autonomous, 19.0 / 120.0 - 1e-9);
+  EXPECT_LT(first_autonomous, 21.0 / 120.0 + 0.01);
+  EXPECT_LT(last_free, first_autonomous);
+  // scenario.state: 'follow' then 'reach' with the transition's label
+  ASSERT_FALSE(states.empty());
+  v1::ScenarioState first, last;
+  ASSERT_TRUE(first.ParseFromString(states.front()));
+  ASSERT_TRUE(last.ParseFromString(states.back()));
+  EXPECT_EQ(first.scenario(), "reach");
+  EXPECT_EQ(first.state(), "follow");
+  EXPECT_EQ(last.state(), "reach");
+  ASSERT_EQ(last.last_events_size(), 1);
+  EXPECT_EQ(last.last_events(0), "operator says go");
+}
+
+TEST(SimConfig, ScenarioErrorsNameTheFileLineAndWhat) {
+  const std::string m = "mannequins:\n  - {name: operator, config: configs/mannequins/male_50th.yaml, control_frames: {hand_l: hand_l}}\n";
+  const auto expectError = [&](const std::string& yaml, const std::string& what) {
+    try {
+      const auto c = simservice::parseSimConfig(core::ConfigNode::parse(yaml + m, "sim.yaml"));
+      sim::World w(simservice::buildMannequins(c), c.world);
+      simservice::setupScenario(w, c);
+      ADD_FAILURE() << "no error for\n" << yaml;
+    } catch (const core::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << "got: " << e.what();
+    }
+  };
+  expectError("scenario: configs/scenarios/nope.yaml\n", "sim.yaml:1: field 'scenario'");
+  expectError("scenario: {file: configs/scenarios/drill.yaml, triggers: [{at: 1, name: guidance}]}\n",
+              "trigger 'guidance' is not declared by scenario 'drill'");
+  expectError("scenario: {file: configs/scenarios/drill.yaml, triggers: [{at: 2, name: guide}, {at: 1, name: abort}]}\n",
+              "triggers must be listed in time order");
+  expectError("scenario: {file: configs/scenarios/drill.yaml, triggers: [{at: -1, name: guide}]}\n", "field 'scenario.triggers[0].at'");
+  expectError("scenario: {file: configs/scenarios/drill.yaml, trigers: []}\n", "unknown key");
+  // the World lacks what the scenario names: the drill scenario's mannequin 'worker'
+  expectError("scenario: configs/scenarios/drill.yaml\n", "no mannequin 'worker'");
 }

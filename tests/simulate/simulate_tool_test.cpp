@@ -283,3 +283,26 @@ TEST_F(SimulateTool, OutFileCarriesTheSceneObjects) {
   }
   fs::remove(mcap);
 }
+
+// --scenario: the jump scenario in the loop of the shipped demo, its timeline in the JSON summary; a bad
+// scenario file: exit 2 naming the file and line, nothing on stdout.
+TEST_F(SimulateTool, ScenarioRunReportsTheStatesEnteredAndABadScenarioNamesItsLine) {
+  const ToolResult a = run("--scenario configs/scenarios/jump.yaml --json", 300);
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  const auto [status, out] = pythonOn(
+      a.out,
+      "s = d['scenario']\nassert s['name'] == 'jump' and s['states'] == 3, s\n"
+      "assert [e['state'] for e in s['timeline']] == ['standing', 'airborne', 'landed'], s\n"
+      "assert s['timeline'][1]['events'] == 'both feet off the floor', s\n"
+      "assert s['timeline'][0]['t'] < s['timeline'][1]['t'] < s['timeline'][2]['t'] <= d['sim_time_s'], s\n"
+      "assert s['final_state'] == 'landed' and s['unapplied_actions'] == 0, s\nprint('ok')");
+  EXPECT_EQ(status, 0) << out << a.out;
+  const fs::path bad = temp("bad_scenario.yaml");
+  std::ofstream(bad) << "scenario: bad\nmannequins:\n  - {name: operator, frames: [hand_r]}\nstates:\n  - name: a\n"
+                        "    transitions: [{to: nowhere, when: {time: 1}}]\n";
+  const ToolResult r = run("--scenario " + bad.string() + " --json");
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(bad.string() + ":6"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("nowhere"), std::string::npos) << r.err;
+  EXPECT_TRUE(r.out.empty()) << r.out;
+}

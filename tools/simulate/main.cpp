@@ -36,6 +36,18 @@ std::string ergonomicsJson(const Summary& s) {
   return out + "]";
 }
 
+std::string scenarioJson(const Summary& s) {
+  if (s.scenario.empty()) return "null";
+  std::string timeline;
+  for (const Summary::ScenarioEntry& e : s.scenario_timeline)
+    timeline += fmt::format("{}{{\"t\": {}, \"state\": {}, \"events\": {}}}", timeline.empty() ? "" : ", ", num(e.t),
+                            core::jsonString(e.state), core::jsonString(e.events));
+  return fmt::format("{{\"name\": {}, \"final_state\": {}, \"states\": {}, \"triggers_sent\": {}, "
+                     "\"unapplied_actions\": {}, \"timeline\": [{}]}}",
+                     core::jsonString(s.scenario), core::jsonString(s.scenario_state), s.scenario_states, s.scenario_triggers,
+                     s.scenario_unapplied_actions, timeline);
+}
+
 void printJson(const Summary& s) {
   std::printf(
       "{\"frames\": %lld, \"steps\": %lld, \"sim_time_s\": %s, \"wall_s\": %s, \"realtime_factor\": %s, "
@@ -44,14 +56,14 @@ void printJson(const Summary& s) {
       "\"worst_joint_limit_excess_rad\": %s, \"min_force_margin_n\": %s, \"mean_force_margin_n\": %s, "
       "\"balance_controller\": {\"enabled\": %s, \"solves\": %lld, \"failures\": %lld, \"driving_fraction\": %s, "
       "\"full_margin_fraction\": %s}, "
-      "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld, \"ergonomics\": %s}\n",
+      "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld, \"ergonomics\": %s, \"scenario\": %s}\n",
       s.frames, s.steps, num(s.sim_time_s).c_str(), num(s.wall_s).c_str(), num(s.realtimeFactor()).c_str(),
       s.physics ? "true" : "false", s.nan_steps, s.lcp_failures, num(s.max_penetration_m).c_str(), s.max_contacts,
       num(s.meanContacts()).c_str(), num(s.footContactFraction()).c_str(), num(s.min_balance_distance_m).c_str(),
       num(s.worst_joint_limit_excess_rad).c_str(), num(s.min_force_margin_n).c_str(), num(s.meanForceMargin()).c_str(),
       s.balance_controller ? "true" : "false", s.balance_solves, s.balance_failures, num(s.balanceDrivingFraction()).c_str(),
       num(s.balanceFullMarginFraction()).c_str(), num(s.meanHandError()).c_str(), num(s.meanFootError()).c_str(),
-      s.worlds, ergonomicsJson(s).c_str());
+      s.worlds, ergonomicsJson(s).c_str(), scenarioJson(s).c_str());
 }
 
 void printHuman(const Summary& s, const std::string& out) {
@@ -88,6 +100,15 @@ void printHuman(const Summary& s, const std::string& out) {
                 e.mannequin.c_str(), e.rula_max, e.rula_time_s[0], e.rula_time_s[1], e.rula_time_s[2], e.rula_time_s[3],
                 e.reba_max, e.reba_time_s[0], e.reba_time_s[1], e.reba_time_s[2], e.reba_time_s[3], e.reba_time_s[4]);
   }
+  if (!s.scenario.empty()) {
+    std::printf("scenario    %s: %zu state change(s), %lld trigger(s) sent, ends in '%s'%s\n", s.scenario.c_str(),
+                s.scenario_timeline.empty() ? 0 : s.scenario_timeline.size() - 1, s.scenario_triggers,
+                s.scenario_state.empty() ? "(never ran: mannequins not calibrated)" : s.scenario_state.c_str(),
+                s.scenario_unapplied_actions > 0 ? fmt::format("; {} action(s) not applied by the World yet",
+                                                               s.scenario_unapplied_actions).c_str() : "");
+    for (const Summary::ScenarioEntry& e : s.scenario_timeline)
+      std::printf("            %8.3f s  %s%s\n", e.t, e.state.c_str(), e.events.empty() ? "" : ("  <- " + e.events).c_str());
+  }
   if (!out.empty()) std::printf("wrote       %lld sim.world messages to %s\n", s.worlds, out.c_str());
 }
 
@@ -96,7 +117,7 @@ void printHuman(const Summary& s, const std::string& out) {
 int main(int argc, char** argv) {
   CLI::App app{"mannequin-simulate: the sim service's World in one process, no network. Feeds a capture's frames at\n"
                "their capture times and steps as fast as possible (deterministic), then prints a summary."};
-  std::string config_path = "configs/sim/sim_demo.yaml", mocap_bvh, mannequin, scene, out, log_level = "warn";
+  std::string config_path = "configs/sim/sim_demo.yaml", mocap_bvh, mannequin, scene, scenario, out, log_level = "warn";
   double duration = -1;
   bool json = false;
   app.add_option("--config,-c", config_path, "sim config (configs/sim/sim_*.yaml)")->capture_default_str();
@@ -104,6 +125,8 @@ int main(int argc, char** argv) {
                                        "(its map and bodies are kept)");
   app.add_option("--mannequin", mannequin, "mannequin config (configs/mannequins/*.yaml) for every mannequin");
   app.add_option("--scene", scene, "scene file (configs/scenes/*.yaml): turns the physics on with this scene");
+  app.add_option("--scenario", scenario, "scenario file (configs/scenarios/*.yaml) run in the loop, replacing the sim "
+                                         "config's `scenario` (docs/scenario.md)");
   app.add_option("--duration", duration, "seconds of simulation (default: the whole capture)")->check(CLI::PositiveNumber);
   app.add_option("--out,-o", out, "MCAP file of the sim.world messages (at the config's world_rate)");
   app.add_flag("--json", json, "print exactly one JSON object on stdout");
@@ -115,6 +138,7 @@ int main(int argc, char** argv) {
     options.mocap = mocap_bvh;
     options.mannequin = mannequin;
     options.scene = scene;
+    options.scenario = scenario;
     options.duration = duration;
     options.out = out;
     options.progress = ::isatty(STDERR_FILENO) == 1;

@@ -417,6 +417,10 @@ struct World::ScenarioRun {
   struct Frame {
     int mannequin = -1;
     std::size_t driven = 0;  // index in the mannequin's DrivenFrames
+    int joint = -1;          // the joint carrying the frame
+    // per joint of the model: 1 if its segment's contacts push on this frame — the joints whose nearest
+    // control-frame joint up the tree (itself included) is this frame's (a foot's toes, a hand's fingers)
+    std::vector<char> force_joints;
   };
   std::vector<Frame> frames;       // per scenario frame
   std::vector<int> objects;        // per scenario object: the World's object index
@@ -443,7 +447,16 @@ void World::setScenario(scenario::Scenario sc) {
     if (driven == mm.frames.size())
       throw std::invalid_argument(where + ": mannequin '" + f.mannequin + "' has no control frame '" + f.frame +
                                   "' driven by mocap (the sim config's control_frames)");
-    run->frames.push_back({m, driven});
+    ScenarioRun::Frame fr{m, driven, mm.model.frames[static_cast<std::size_t>(mm.frames[driven].frame_index)].joint, {}};
+    std::vector<char> control_joint(mm.model.joints.size(), 0);
+    for (const DrivenFrame& d : mm.frames) control_joint[static_cast<std::size_t>(mm.model.frames[static_cast<std::size_t>(d.frame_index)].joint)] = 1;
+    fr.force_joints.assign(mm.model.joints.size(), 0);
+    for (std::size_t j = 0; j < mm.model.joints.size(); ++j) {
+      int a = static_cast<int>(j);
+      while (a >= 0 && !control_joint[static_cast<std::size_t>(a)]) a = mm.model.joints[static_cast<std::size_t>(a)].parent;
+      fr.force_joints[j] = a == fr.joint;
+    }
+    run->frames.push_back(std::move(fr));
   }
   for (const scenario::ObjectDecl& o : sc.objects) {
     const int k = physics_ ? findObject(o.name) : -1;
@@ -480,6 +493,23 @@ void World::stepScenario() {
     obs.frames[i].pose = st.actual;
     obs.frames[i].target = st.target;  // the mocap target driveTargets just set
     obs.frames[i].force.setZero();
+    if (S.grasp_handle[i] >= 0) obs.frames[i].force = -graspForce(S.grasp_handle[i]);  // the object's pull on the hand
+  }
+  if (physics_) {
+    // the contact forces of the last step on each commanded frame's segments (normal forces: the friction
+    // rows' directions are not reported); a contact's force on body a is −λ n (n from a to b)
+    const Physics& P = *physics_;
+    for (const ContactReport& c : contacts_)
+      for (std::size_t i = 0; i < S.frames.size(); ++i) {
+        const ScenarioRun::Frame& f = S.frames[i];
+        const auto on = [&](int body) {
+          if (body < 0 || P.body_mannequin[static_cast<std::size_t>(body)] != f.mannequin) return false;
+          const int j = P.body_joint[static_cast<std::size_t>(body)];
+          return j >= 0 && f.force_joints[static_cast<std::size_t>(j)] != 0;
+        };
+        if (on(c.body_a)) obs.frames[i].force -= c.normal_force * c.normal;
+        if (on(c.body_b)) obs.frames[i].force += c.normal_force * c.normal;
+      }
   }
   for (std::size_t k = 0; k < S.objects.size(); ++k) {
     const RigidObject& o = object(S.objects[k]);
@@ -510,6 +540,7 @@ void World::stepScenario() {
     Mannequin& m = *mannequins_[static_cast<std::size_t>(S.frames[i].mannequin)];
     DrivenFrame& st = m.frames[S.frames[i].driven];
     st.target = c.setpoint.pose;
+    st.mode = scenario::toString(c.mode);
     // the setpoint's world twist (ω, v) as the target's body twist (Rᵀω, Rᵀv), fed forward
     math::Vector6 V;
     V.head<3>() = c.setpoint.pose.R.transpose() * c.setpoint.twist.head<3>();

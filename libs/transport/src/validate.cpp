@@ -34,6 +34,16 @@ std::string validateContactSet(const v1::ContactSet& contacts) {
   return {};
 }
 
+std::string validateTrigger(const v1::Trigger& trigger) {
+  const std::string& n = trigger.name();
+  if (n.empty()) return "trigger without a name";
+  if (n.size() > 128) return fmt::format("trigger name of {} characters (at most 128)", n.size());
+  for (const char c : n)
+    if (static_cast<unsigned char>(c) < 0x20 || c == 0x7f) return "trigger name with a control character";
+  if (trigger.value().size() > 4096) return fmt::format("trigger '{}': value of {} bytes (at most 4096)", n, trigger.value().size());
+  return {};
+}
+
 std::string validateCollisionQuery(const v1::CollisionQuery& query) {
   for (int i = 0; i < query.bodies_size(); ++i) {
     const std::string why = checkPose(query.bodies(i).pose());

@@ -23,6 +23,56 @@ std::string resolvePath(const ConfigNode& node) {
   }
 }
 
+namespace {
+
+/// The triggers' names must be the scenario's declared ones (a typo would never fire).
+void checkTriggers(const ScenarioSettings& s, const std::vector<ConfigNode>* at) {
+  for (std::size_t i = 0; i < s.triggers.size(); ++i)
+    if (s.scenario.triggerIndex(s.triggers[i].name) < 0) {
+      std::string list;
+      for (const std::string& t : s.scenario.triggers) list += (list.empty() ? "" : ", ") + t;
+      const std::string why = "trigger '" + s.triggers[i].name + "' is not declared by scenario '" + s.scenario.name + "' (" +
+                              s.scenario.source + ": triggers: " + (list.empty() ? std::string("none") : list) + ")";
+      if (at != nullptr) (*at)[i]["name"].fail(why);
+      throw core::ConfigError(s.where + ": " + why);
+    }
+}
+
+void loadScenarioFile(const ConfigNode& node, ScenarioSettings& s) {
+  s.file = resolvePath(node);
+  try {
+    s.scenario = scenario::loadScenario(s.file);
+  } catch (const std::exception& e) {
+    node.fail(std::string("scenario: ") + e.what());  // the scenario file's own FILE:LINE error follows
+  }
+}
+
+/// `scenario: FILE` or `scenario: {file, triggers: [{at, name, value}], state_rate}`.
+void parseScenarioSettings(const ConfigNode& sc, ScenarioSettings& s) {
+  s.where = sc.where();
+  if (sc.isScalar()) {
+    loadScenarioFile(sc, s);
+    return;
+  }
+  sc.allowOnly({"file", "triggers", "state_rate"});
+  loadScenarioFile(sc["file"], s);
+  s.state_rate = sc.getIn("state_rate", s.state_rate, 0.1, 1000.0);
+  std::vector<ConfigNode> nodes;
+  if (auto tr = sc.find("triggers")) nodes = tr->items();
+  for (const ConfigNode& t : nodes) {
+    t.allowOnly({"at", "name", "value"});
+    TimedTrigger x;
+    x.at = t["at"].nonNegative();
+    x.name = t["name"].str();
+    x.value = t.get("value", std::string());
+    if (!s.triggers.empty() && x.at < s.triggers.back().at) t["at"].fail("triggers must be listed in time order");
+    s.triggers.push_back(x);
+  }
+  checkTriggers(s, &nodes);
+}
+
+}  // namespace
+
 void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
   ph.allowOnly({"enabled", "gravity", "scene", "segment_margin", "segment_material", "self_collision", "query_period_steps", "activation_distance",
                 "calibration_clearance", "friction_edges", "recovery_speed", "max_rows", "balance_rows",
@@ -87,7 +137,7 @@ void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
 SimServiceConfig parseSimConfig(const ConfigNode& root) {
   root.allowOnly({"name", "publish", "connect", "mode", "step", "world_rate", "publish_on_mocap", "interpolation_delay",
                   "reanchor_threshold", "occlusion", "calibration", "gains", "collision", "mannequins", "stepper",
-                  "target_twist", "joint_limits", "physics", "mocap", "mocap_sources", "status_period"});
+                  "target_twist", "joint_limits", "physics", "mocap", "mocap_sources", "status_period", "scenario"});
   SimServiceConfig c;
   c.name = root.get("name", c.name);
   if (auto p = root.find("publish")) c.publish = p->strings();
@@ -154,6 +204,7 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
   if (auto ph = root.find("physics")) parsePhysics(*ph, c.world.physics);
   if (auto mo = root.find("mocap")) c.mocap = resolvePath(*mo);
   c.status_period = root.getIn("status_period", c.status_period, 0.0, 3600.0);
+  if (auto sc = root.find("scenario")) parseScenarioSettings(*sc, c.scenario);
   if (auto ms = root.find("mocap_sources"))
     for (const ConfigNode& s : ms->items()) {
       s.allowOnly({"name", "connect"});
@@ -239,6 +290,38 @@ std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config)
     out.push_back(std::move(s));
   }
   return out;
+}
+
+void setupScenario(sim::World& world, const SimServiceConfig& config) {
+  if (config.scenario.file.empty()) return;
+  try {
+    world.setScenario(config.scenario.scenario);
+  } catch (const std::invalid_argument& e) {
+    throw core::ConfigError(config.scenario.where + ": field 'scenario': " + config.scenario.file + ": " + e.what());
+  }
+}
+
+void replaceScenario(SimServiceConfig& config, const std::string& file) {
+  ScenarioSettings s;
+  s.where = "--scenario";
+  s.file = core::findData(file);
+  s.scenario = scenario::loadScenario(s.file);
+  s.state_rate = config.scenario.state_rate;
+  if (!config.scenario.file.empty()) {
+    s.triggers = config.scenario.triggers;
+    s.where = config.scenario.where;
+    checkTriggers(s, nullptr);
+    s.where = "--scenario";
+  }
+  config.scenario = std::move(s);
+}
+
+int TriggerSchedule::due(sim::World& world) {
+  int n = 0;
+  const double now = world.time() + 0.5 * world.config().step;
+  for (; next_ < triggers_->size() && (*triggers_)[next_].at <= now; ++next_, ++n)
+    world.trigger((*triggers_)[next_].name, (*triggers_)[next_].value);
+  return n;
 }
 
 }  // namespace mannequin::simservice

@@ -109,7 +109,7 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
       v1::ControlFrameState* c = ms->add_control_frames();
       c->set_frame(st.frame);
       c->set_body(st.body);
-      c->set_mode("free");
+      c->set_mode(st.mode);
       toMsg(st.target, *c->mutable_target());
       toMsg(st.actual, *c->mutable_actual());
       c->set_position_error(st.position_error);
@@ -173,6 +173,16 @@ void toCollisionQuery(const sim::World& world, double margin, v1::CollisionQuery
     m->set_name(world.name(i));
     for (int k = 0; k < world.model(i).nq; ++k) m->add_q(world.q(i)(k));
   }
+}
+
+void toScenarioState(const scenario::Engine& engine, double sim_time, v1::ScenarioState& out) {
+  out.Clear();
+  out.mutable_header()->set_stamp_ns(static_cast<std::int64_t>(std::llround(sim_time * 1e9)));
+  out.set_scenario(engine.scenario().name);
+  out.set_state(engine.stateName());
+  out.set_time_in_state(engine.timeInState());
+  for (const std::string& s : engine.contextStack()) out.add_context_stack(s);
+  for (const std::string& s : engine.lastEvents()) out.add_last_events(s);
 }
 
 }  // namespace mannequin::simservice

@@ -198,7 +198,9 @@ OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
           capture_length_s_ = b->bvh().num_frames * b->bvh().frame_time / raw["bvh"]["rate"].as<double>(1.0);
       }
     }
+    if (!options.scenario.empty()) replaceScenario(c, options.scenario);
     world_ = std::make_unique<sim::World>(buildMannequins(c), c.world);
+    setupScenario(*world_, c);
   } catch (const OfflineInputError&) {
     throw;
   } catch (const std::exception& e) {  // a bad file: its FILE:LINE message
@@ -224,15 +226,50 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
   for (int m = 0; m < world.numMannequins(); ++m) s.ergonomics.push_back({world.name(m)});
 
   std::unique_ptr<recording::McapWriter> writer;
-  std::uint16_t channel = 0;
+  std::uint16_t channel = 0, state_channel = 0;
+  std::string payload;
   if (!options_.out.empty()) {
     writer = std::make_unique<recording::McapWriter>(options_.out);
     const std::uint16_t schema = writer->addSchema("mannequin.v1.WorldState", "protobuf",
                                                    proto::fileDescriptorSet(v1::WorldState::descriptor()));
     channel = writer->addChannel(std::string(transport::topics::kSimWorld.name), schema, "protobuf");
+    if (world.scenarioEngine() != nullptr) {
+      const std::uint16_t sc_schema = writer->addSchema("mannequin.v1.ScenarioState", "protobuf",
+                                                        proto::fileDescriptorSet(v1::ScenarioState::descriptor()));
+      state_channel = writer->addChannel(std::string(transport::topics::kScenarioState.name), sc_schema, "protobuf");
+    }
   }
+  // the scenario: its timeline, and scenario.state in the recording (at state_rate and at every switch)
+  TriggerSchedule triggers(config.scenario.triggers);
+  v1::ScenarioState state_msg;
+  std::uint32_t state_seq = 0;
+  double state_phase = 0.0;
+  int last_state = -1;
+  const auto scenarioAfterStep = [&] {
+    const scenario::Engine* e = world.scenarioEngine();
+    if (e == nullptr || e->state() < 0) return;  // not run yet (mannequins not calibrated)
+    const bool switched = e->state() != last_state;
+    if (switched) {
+      std::string events;
+      if (last_state >= 0)
+        for (const std::string& l : e->lastEvents()) events += (events.empty() ? "" : "; ") + l;
+      s.scenario_timeline.push_back({world.time(), e->stateName(), events});
+      last_state = e->state();
+    }
+    state_phase += config.scenario.state_rate * config.world.step;
+    const bool scheduled = state_phase >= 1.0 - 1e-9;
+    if (scheduled) state_phase -= 1.0;
+    if (!writer || !(scheduled || switched)) return;
+    toScenarioState(*e, world.time(), state_msg);
+    v1::Header* h = state_msg.mutable_header();
+    h->set_schema_version(transport::kSchemaVersion);
+    h->set_sequence(++state_seq);
+    h->set_source(config.name);
+    state_msg.SerializeToString(&payload);
+    const auto t = static_cast<recording::Timestamp>(h->stamp_ns());
+    writer->write(state_channel, state_seq, t, t, payload);
+  };
   v1::WorldState msg;
-  std::string payload;
   double world_phase = 0.0;
   std::vector<ergonomics::Assessment> assessments(static_cast<std::size_t>(world.numMannequins()));
   std::vector<const ergonomics::Assessment*> sampled(static_cast<std::size_t>(world.numMannequins()), nullptr);
@@ -304,10 +341,12 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
           done = true;
           break;
         }
+        s.scenario_triggers += triggers.due(world);
         const double before = on_step ? wall() : 0.0;
         const bool ok = world.step();
         if (on_step) on_step(world, wall() - before);
         accumulate(world, ok, s);
+        scenarioAfterStep();
         publish();
         progress.update(world.time(), wall());
       }
@@ -329,6 +368,12 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
     }
   progress.done();
   s.sim_time_s = world.time();
+  if (const scenario::Engine* e = world.scenarioEngine()) {
+    s.scenario = e->scenario().name;
+    s.scenario_states = static_cast<long long>(e->scenario().states.size());
+    s.scenario_state = last_state >= 0 ? e->stateName() : "";
+    s.scenario_unapplied_actions = world.scenarioUnappliedActions();
+  }
   if (const constraints::ConstraintSolver* cs = world.constraintSolver()) s.lcp_failures = cs->failures();
   if (writer) writer->close();
   return s;

@@ -60,13 +60,20 @@ struct SimService::Impl {
   std::int64_t query_sent_ns = 0;
   v1::WorldState world_msg;
   v1::CollisionQuery query_msg;
+  // the scenario (config key `scenario`): timed triggers, scenario.state at state_rate and at switches
+  TriggerSchedule schedule;
+  v1::ScenarioState scenario_msg;
+  double state_phase = 0.0;
+  int last_state = -1;
 
   Impl(const SimServiceConfig& c, zmq::context_t& ctx, double hb)
       : config(c),
         world(buildMannequins(c), c.world),
         pub(ctx, transport::PublisherOptions{c.name, c.publish, 1000, c.mode == Mode::kReplay}),
         sub(ctx, transport::SubscriberOptions{c.name, subscriberEndpoints(c), c.mode == Mode::kReplay ? 100000 : 1000, 10000}),
-        health(pub, c.name, &sub, hb) {
+        health(pub, c.name, &sub, hb),
+        schedule(config.scenario.triggers) {
+    setupScenario(world, config);
     world_sources = world.mocapSources();
     period.reset(world.numMannequins());
     run_totals.reset(world.numMannequins());
@@ -76,6 +83,39 @@ struct SimService::Impl {
     sub.subscribe(topics::kCollisionContacts,
                   std::function<void(const v1::ContactSet&)>([this](const v1::ContactSet& s) { onContacts(s); }),
                   transport::validateContactSet);
+    if (world.scenarioEngine() != nullptr)
+      sub.subscribe(topics::kScenarioTrigger,
+                    std::function<void(const v1::Trigger&)>([this](const v1::Trigger& t) { onTrigger(t); }),
+                    transport::validateTrigger);
+  }
+
+  void onTrigger(const v1::Trigger& t) {
+    const scenario::Engine& e = *world.scenarioEngine();
+    if (e.scenario().triggerIndex(t.name()) < 0)
+      spdlog::warn("{}: trigger '{}' from {}: scenario '{}' does not declare it (ignored)", config.name, t.name(),
+                   t.header().source(), e.scenario().name);
+    else
+      spdlog::info("{}: trigger '{}'{} from {}", config.name, t.name(), t.value().empty() ? "" : " = " + t.value(), t.header().source());
+    world.trigger(t.name(), t.value());
+  }
+
+  void publishScenario() {
+    const scenario::Engine* e = world.scenarioEngine();
+    if (e == nullptr || e->state() < 0) return;  // not run yet (mannequins not calibrated)
+    const bool switched = e->state() != last_state;
+    if (switched) {
+      std::string events;
+      for (const std::string& l : e->lastEvents()) events += (events.empty() ? "" : "; ") + l;
+      spdlog::info("{}: scenario '{}' at {:.3f} s: state '{}'{}", config.name, e->scenario().name, world.time(), e->stateName(),
+                   last_state < 0 || events.empty() ? "" : " (" + events + ")");
+      last_state = e->state();
+    }
+    state_phase += config.scenario.state_rate * config.world.step;
+    const bool scheduled = state_phase >= 1.0 - 1e-9;
+    if (scheduled) state_phase -= 1.0;
+    if (!(scheduled || switched)) return;
+    toScenarioState(*e, world.time(), scenario_msg);
+    pub.publish(topics::kScenarioState, scenario_msg);
   }
 
   static std::vector<std::string> subscriberEndpoints(const SimServiceConfig& c) {
@@ -220,7 +260,9 @@ struct SimService::Impl {
 
   void stepOnce(const std::atomic<bool>& stop) {
     collisionBeforeStep(stop);
+    schedule.due(world);
     world.step();
+    publishScenario();
     ++stats.steps;
     accumulate();
     health.loopIteration();

@@ -232,6 +232,8 @@ struct DrivenFrame {
   double weight = 0.0;
   double position_error = 0.0;     ///< m
   double orientation_error = 0.0;  ///< rad
+  /// Its command mode (scenario::toString of scenario::ControlMode): "free" unless a scenario commands it.
+  const char* mode = "free";
 };
 
 class World {
@@ -302,7 +304,8 @@ class World {
   /// \throws std::invalid_argument naming an unknown mannequin, frame or object, or physics off.
   /// Runs a scenario's state machine in the loop (thesis 4.1.2, libs/scenario): every step, once all its
   /// mannequins are calibrated, its engine sees the commanded control frames (simulated pose, mocap target;
-  /// contact force not reported yet: zero) and its objects (pose; the value `angle` of a hinged object),
+  /// force: the normal forces of the last step's contacts on the segments the frame carries — its own and
+  /// those below it up to the next control frame, e.g. a foot's toes — plus the pull of an object it grasps) and its objects (pose; the value `angle` of a hinged object),
   /// and its setpoints replace those frames' targets — free: the mocap target; constrained: projected on
   /// the mechanism; autonomous: the trajectory — velocity-continuous across switches (their world twist
   /// fed forward as the targets' body twist). Its grasp/release actions call grasp()/release() (physics

@@ -15,5 +15,7 @@ std::string validateMocapFrame(const v1::MocapFrame& frame);
 std::string validateContactSet(const v1::ContactSet& contacts);
 /// Every body pose finite with a unit quaternion.
 std::string validateCollisionQuery(const v1::CollisionQuery& query);
+/// A name (1–128 characters, no control characters) and a value of at most 4096 bytes.
+std::string validateTrigger(const v1::Trigger& trigger);
 
 }  // namespace mannequin::transport

@@ -5,6 +5,7 @@
 #include <vector>
 
 #include "mannequin/core/config.hpp"
+#include "mannequin/scenario/scenario.hpp"
 #include "mannequin/sim/world.hpp"
 
 namespace mannequin::simservice {
@@ -41,6 +42,23 @@ struct MocapSourceEntry {
   std::vector<std::string> connect;  ///< its publisher endpoints (added to the subscriber's; may be empty)
 };
 
+/// An operator trigger at a sim time (key `scenario.triggers`): what a scripted run (mannequin-simulate,
+/// replay) gives the scenario where an operator would press a button.
+struct TimedTrigger {
+  double at = 0;  ///< s of sim time
+  std::string name, value;
+};
+
+/// Key `scenario`: a scenario file (configs/scenarios/*.yaml) run by the World's loop (World::setScenario),
+/// its state published on scenario.state, operator triggers read from scenario.trigger and `triggers`.
+struct ScenarioSettings {
+  std::string file;                    ///< "" : no scenario
+  scenario::Scenario scenario;         ///< loaded and validated at parse
+  std::vector<TimedTrigger> triggers;  ///< sorted by time
+  double state_rate = 10.0;            ///< scenario.state per second of sim time (and at every switch)
+  std::string where;                   ///< "FILE:LINE" of the key in the sim config
+};
+
 /// What steps the mannequins: the control library's Controller (default) or the KinematicTracker.
 enum class StepperKind { kController, kKinematic };
 
@@ -61,6 +79,7 @@ struct SimServiceConfig {
   /// reads the capture from when run offline; found with core::findData, else beside the sim config.
   /// The service ignores it (it gets mocap.frame). "" when absent.
   std::string mocap;
+  ScenarioSettings scenario;  ///< key `scenario` (file "" when absent)
 };
 
 /// Key `physics` (sim::PhysicsConfig, docs/cluster.md): {enabled, gravity, scene (a scene file, collision::loadScene),
@@ -78,5 +97,26 @@ std::string resolvePath(const core::ConfigNode& node);
 /// \throws core::ConfigError "FILE:LINE: field 'mannequins[i]': mannequin 'a': ..." naming the entry, then
 /// the failure (a mannequin or controller config's own FILE:LINE error, a control frame the model lacks).
 std::vector<sim::MannequinSetup> buildMannequins(const SimServiceConfig& config);
+
+/// Sets the config's scenario (if any) on the World. \throws core::ConfigError at the sim config's
+/// `scenario` key naming what the World lacks (a mannequin, control frame, object or value).
+void setupScenario(sim::World& world, const SimServiceConfig& config);
+
+/// Replaces the config's scenario with a file's (mannequin-simulate --scenario): its timed triggers are
+/// kept when they are the new scenario's, else refused. \throws core::ConfigError.
+void replaceScenario(SimServiceConfig& config, const std::string& file);
+
+/// Feeds a run's timed triggers to the World as sim time passes (before each step).
+class TriggerSchedule {
+ public:
+  explicit TriggerSchedule(const std::vector<TimedTrigger>& triggers) : triggers_(&triggers) {}
+  /// Sends every trigger due at the World's time (at <= time + step/2); returns how many.
+  int due(sim::World& world);
+  std::size_t sent() const { return next_; }
+
+ private:
+  const std::vector<TimedTrigger>* triggers_;
+  std::size_t next_ = 0;
+};
 
 }  // namespace mannequin::simservice

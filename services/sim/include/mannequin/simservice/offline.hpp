@@ -56,6 +56,17 @@ struct OfflineSummary {
   long long hand_samples = 0, foot_samples = 0;
   bool physics = false;
   std::vector<ErgonomicsSummary> ergonomics;
+  /// The scenario (sim config `scenario`, --scenario): "" without one; the states entered with their sim
+  /// time (the initial state at the first step the engine ran), the triggers sent, the actions the World
+  /// does not apply yet (World::scenarioUnappliedActions).
+  struct ScenarioEntry {
+    double t = 0;
+    std::string state;
+    std::string events;  ///< the fired transitions' labels ("" for the initial state)
+  };
+  std::string scenario, scenario_state;
+  std::vector<ScenarioEntry> scenario_timeline;
+  long long scenario_triggers = 0, scenario_unapplied_actions = 0, scenario_states = 0;
 
   double meanContacts() const { return steps > 0 ? contact_sum / static_cast<double>(steps) : 0.0; }
   double footContactFraction() const {
@@ -91,6 +102,7 @@ struct OfflineOptions {
   std::string c3d_mapping = "configs/mappings/c3d_sample01.yaml";
   std::string mannequin;  ///< mannequin config for every mannequin ("" keeps the sim config's)
   std::string scene;      ///< scene file: turns the physics on with this scene ("" keeps the config's)
+  std::string scenario;   ///< scenario file replacing the config's `scenario` ("" keeps the config's)
   double duration = -1;   ///< s of simulation (≤ 0: the whole capture)
   std::string out;        ///< MCAP file of the sim.world messages ("" none)
   bool progress = false;  ///< a progress bar with ETA on stderr
