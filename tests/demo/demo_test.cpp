@@ -33,6 +33,7 @@ TEST(Demo, Fig48JumpWithSixControlFramesBothFeetLeaveTheFloorAndLandWithoutPenet
   double lowest_sole = 1e9, margin = -1, w_step = 0;
   long airborne_steps = 0, airborne_feet_touching = 0, flight = 0, longest_flight = 0;
   bool standing_at_end = false;
+  double standing_ankle = 0;  // the highest foot control frame over the first 0.5 s standing
   const simservice::OfflineSummary s = run.run({}, [&](const sim::World& w, double) {
     margin = w.config().physics.segment_margin;
     w_step = w.config().step;
@@ -42,6 +43,9 @@ TEST(Demo, Fig48JumpWithSixControlFramesBothFeetLeaveTheFloorAndLandWithoutPenet
     if (e->state() >= 0) {
       if (spans.empty() || spans.back().state != e->stateName()) spans.push_back({e->stateName(), w.time(), w.time()});
       spans.back().to = w.time();
+      if (e->stateName() == "standing" && e->timeInState() < 0.5)
+        for (const sim::DrivenFrame& f : w.controlFrames(0))
+          if (f.frame == "foot_l" || f.frame == "foot_r") standing_ankle = std::max(standing_ankle, f.actual.p.z());
       if (e->stateName() == "airborne") {
         ++airborne_steps;
         airborne_feet_touching += d.foot_contact ? 1 : 0;
@@ -55,8 +59,8 @@ TEST(Demo, Fig48JumpWithSixControlFramesBothFeetLeaveTheFloorAndLandWithoutPenet
   std::string timeline;
   for (const StateSpan& sp : spans) timeline += sp.state + " [" + std::to_string(sp.from) + ", " + std::to_string(sp.to) + "] ";
   std::printf("jump: %s| airborne %ld steps (a foot within touching distance in %ld, longest flight %ld steps), lowest sole "
-              "%.4f m (margin %.3f), NaN steps %lld\n",
-              timeline.c_str(), airborne_steps, airborne_feet_touching, longest_flight, lowest_sole, margin, s.nan_steps);
+              "%.4f m (margin %.3f), NaN steps %lld, ankles standing at most %.3f m\n",
+              timeline.c_str(), airborne_steps, airborne_feet_touching, longest_flight, lowest_sole, margin, s.nan_steps, standing_ankle);
   ASSERT_EQ(spans.size(), 3u) << timeline;
   EXPECT_EQ(spans[0].state, "standing");
   EXPECT_EQ(spans[1].state, "airborne");
@@ -66,6 +70,8 @@ TEST(Demo, Fig48JumpWithSixControlFramesBothFeetLeaveTheFloorAndLandWithoutPenet
   EXPECT_GT(static_cast<double>(longest_flight) * w_step, 0.1);
   EXPECT_GE(lowest_sole, -margin);               // no penetration beyond the margin, take-off and landing included
   EXPECT_EQ(s.nan_steps, 0);
+  // the scenario's 14 cm zone is above the ankles of the standing mannequin (else it would say nothing)
+  EXPECT_LT(standing_ankle, 0.14);
   EXPECT_TRUE(standing_at_end);                  // landed on its feet
   EXPECT_EQ(s.scenario, "jump");
   EXPECT_EQ(s.scenario_state, "landed");
