@@ -74,6 +74,25 @@ void ControllerStepper::setTarget(int i, const math::SE3& oMd, const math::Vecto
   }
 }
 
+void ControllerStepper::setGains(int i, const math::Vector6* stiffness, const math::Vector6* damping) {
+  Driven& d = map_.at(i);
+  const math::Vector6 K = stiffness != nullptr ? *stiffness : d.K0, B = damping != nullptr ? *damping : d.B0;
+  const double w = d.weight < 0 ? 1.0 : d.weight;
+  controller_->setGains(d.index, w * K, w * B);  // throws on bad gains, before anything changes
+  d.K0 = K;
+  d.B0 = B;
+}
+
+void ControllerStepper::setMechanism(int i, const control::MechanismConfig* mechanism) {
+  const Driven& d = map_.at(i);
+  if (mechanism == nullptr) {
+    if (controller_->frame(d.index).mechanism_enabled) controller_->setMechanismEnabled(d.index, false);
+    return;
+  }
+  controller_->attachMechanism(d.index, *mechanism);
+  controller_->setMechanismEnabled(d.index, true);
+}
+
 double ControllerStepper::portEnergy() const {
   double e = 0.0;
   for (int c = 0; c < controller_->numFrames(); ++c) e += controller_->frame(c).port.energy;

@@ -425,6 +425,7 @@ struct World::ScenarioRun {
   std::vector<Frame> frames;       // per scenario frame
   std::vector<int> objects;        // per scenario object: the World's object index
   std::vector<int> grasp_handle;   // per scenario frame: its grasp (−1: none)
+  std::vector<const control::MechanismConfig*> mechanism;  // per scenario frame: the one its controller runs (into the engine's scenario)
   std::vector<scenario::Trigger> pending;
   scenario::Observation obs;
   long unapplied = 0;
@@ -468,6 +469,7 @@ void World::setScenario(scenario::Scenario sc) {
     run->objects.push_back(k);
   }
   run->grasp_handle.assign(run->frames.size(), -1);
+  run->mechanism.assign(run->frames.size(), nullptr);
   run->obs.frames.resize(run->frames.size());
   run->obs.objects.resize(run->objects.size());
   for (std::size_t k = 0; k < run->objects.size(); ++k) run->obs.objects[k].values.resize(sc.objects[k].values.size());
@@ -527,6 +529,15 @@ void World::stepScenario() {
       const ScenarioRun::Frame& f = S.frames[static_cast<std::size_t>(act.frame)];
       S.grasp_handle[static_cast<std::size_t>(act.frame)] =
           grasp(f.mannequin, sc.frames[static_cast<std::size_t>(act.frame)].frame, sc.objects[static_cast<std::size_t>(act.object)].name);
+    } else if (act.kind == scenario::Action::Kind::kSetGains && frame_ok) {
+      const ScenarioRun::Frame& f = S.frames[static_cast<std::size_t>(act.frame)];
+      auto* cs = dynamic_cast<ControllerStepper*>(mannequins_[static_cast<std::size_t>(f.mannequin)]->stepper.get());
+      try {
+        if (cs == nullptr) throw std::invalid_argument("no controller");
+        cs->setGains(static_cast<int>(f.driven), act.stiffness ? &*act.stiffness : nullptr, act.damping ? &*act.damping : nullptr);
+      } catch (const std::invalid_argument&) {
+        ++S.unapplied;  // the kinematic tracker has no gains to set; bad gains are refused at load
+      }
     } else if (act.kind == scenario::Action::Kind::kRelease && frame_ok) {
       int& h = S.grasp_handle[static_cast<std::size_t>(act.frame)];
       if (h >= 0) release(h);
@@ -547,6 +558,19 @@ void World::stepScenario() {
     V.tail<3>() = c.setpoint.pose.R.transpose() * c.setpoint.twist.tail<3>();
     const double w = c.mode == scenario::ControlMode::kFree ? m.weights[S.frames[i].driven] : 1.0;
     m.stepper->setTarget(static_cast<int>(S.frames[i].driven), st.target, V, w);
+    // constrained: the controller's virtual mechanism (thesis 4.1.1) guides the frame besides the
+    // projected setpoint; attached at the switch, disabled when the mode changes
+    const control::MechanismConfig* mech =
+        c.mode == scenario::ControlMode::kConstrained && c.spec != nullptr && c.spec->mechanism ? &*c.spec->mechanism : nullptr;
+    if (mech != S.mechanism[i]) {
+      auto* cs = dynamic_cast<ControllerStepper*>(m.stepper.get());
+      try {
+        if (cs != nullptr) cs->setMechanism(static_cast<int>(S.frames[i].driven), mech);
+      } catch (const std::invalid_argument&) {
+        ++S.unapplied;  // validated at load: not expected
+      }
+      S.mechanism[i] = mech;
+    }
   }
 }
 

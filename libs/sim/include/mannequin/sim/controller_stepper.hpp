@@ -57,6 +57,15 @@ class ControllerStepper final : public Stepper {
   double portEnergy() const override;
   std::string_view kind() const override { return "controller"; }
 
+  /// Gains of the World's control frame i at weight 1 (gain tuning, thesis 4.1.1; the occlusion weight
+  /// still scales them); nullptr keeps that one. \throws std::invalid_argument on negative/non-finite gains.
+  void setGains(int i, const math::Vector6* stiffness, const math::Vector6* damping);
+  /// Constrained mode (thesis 4.1.1): attaches `mechanism` to the World's control frame i and enables it
+  /// (its effector starts at the projection of the frame's current pose); nullptr disables the frame's
+  /// mechanism. Allocates when attaching (at a mode switch, not every step).
+  /// \throws std::invalid_argument as Controller::attachMechanism (bad gains or mechanism).
+  void setMechanism(int i, const control::MechanismConfig* mechanism);
+
   /// The controller (for its energies, wrenches, stability check, mechanisms).
   const control::Controller& controller() const { return *controller_; }
   control::Controller& controller() { return *controller_; }

@@ -308,8 +308,10 @@ class World {
   /// those below it up to the next control frame, e.g. a foot's toes — plus the pull of an object it grasps) and its objects (pose; the value `angle` of a hinged object),
   /// and its setpoints replace those frames' targets — free: the mocap target; constrained: projected on
   /// the mechanism; autonomous: the trajectory — velocity-continuous across switches (their world twist
-  /// fed forward as the targets' body twist). Its grasp/release actions call grasp()/release() (physics
-  /// on); the others (attach/detach guide, set gains) are counted in scenarioUnappliedActions(), not applied.
+  /// fed forward as the targets' body twist); a constrained mode also runs its virtual mechanism in the
+  /// controller (ControllerStepper::setMechanism, from the switch until the mode changes). Its grasp/release
+  /// actions call grasp()/release() (physics on), set_gains ControllerStepper::setGains; attach/detach
+  /// guide (and set_gains with the kinematic stepper) are counted in scenarioUnappliedActions(), not applied.
   /// \throws std::invalid_argument naming a mannequin, frame, object or value the World lacks.
   void setScenario(scenario::Scenario s);
   /// An operator trigger, seen by the scenario at the next step.
