@@ -8,6 +8,8 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include "mannequin/collision/geometry.hpp"
 
@@ -299,10 +301,137 @@ void boxRound(const ShapeView& box, const ShapeView& y, double cutoff, const Nar
   out.push_back({box.oMs.act(surface), box.oMs.act(s) - y.shape->radius * n, n, d, -1});
 }
 
+// ---- overlapping convex pairs: separating-axis depth ----------------------------------------
+// Penetration depth and witness points of two overlapping convex primitives (box, cylinder, capsule,
+// sphere) by the separating-axis test: along a unit direction L from x to y the overlap is
+// h_x(L) + h_y(−L) (h the support function); the depth is its minimum over the candidate axes — box face
+// normals, the cylinder/capsule axes, their pairwise cross products and the line between the shapes'
+// cores. Exact for box–box (the 15 axes of the OBB test); for round shapes an upper bound that is exact
+// when the deepest direction is one of the candidates (a face, an end cap, a side). Not libccd's EPA
+// (GJKSolver_libccd::shapeSignedDistance): the Debian build of FCL 0.7 keeps its assertions and that EPA
+// aborts the process on some overlaps (FCL issue #322, `isOutsidePolytopeFace` in ComputeVisiblePatch);
+// nor FCL's own EPA (GJKSolver_indep), which returns wrong depths on overlapping boxes. No allocation.
+namespace {
+
+double support(const ShapeView& s, const Vector3& u) {
+  const Vector3 c = s.oMs.p;
+  const Vector3 a = s.oMs.R.col(2);
+  const Shape& sh = *s.shape;
+  switch (sh.type) {
+    case ShapeType::kBox: {
+      double h = c.dot(u);
+      for (int i = 0; i < 3; ++i) h += 0.5 * sh.size[i] * std::abs(u.dot(s.oMs.R.col(i)));
+      return h;
+    }
+    case ShapeType::kCylinder: {
+      const double ua = u.dot(a);
+      return c.dot(u) + 0.5 * sh.length * std::abs(ua) + sh.radius * (u - ua * a).norm();
+    }
+    case ShapeType::kCapsule: return c.dot(u) + 0.5 * sh.length * std::abs(u.dot(a)) + sh.radius * u.norm();
+    case ShapeType::kSphere: return c.dot(u) + sh.radius * u.norm();
+    default: return 0.0;
+  }
+}
+
+Vector3 supportPoint(const ShapeView& s, const Vector3& u) {
+  const Vector3 c = s.oMs.p;
+  const Vector3 a = s.oMs.R.col(2);
+  const Shape& sh = *s.shape;
+  switch (sh.type) {
+    case ShapeType::kBox: {
+      Vector3 p = c;
+      for (int i = 0; i < 3; ++i) p += 0.5 * sh.size[i] * (u.dot(s.oMs.R.col(i)) >= 0.0 ? 1.0 : -1.0) * s.oMs.R.col(i);
+      return p;
+    }
+    case ShapeType::kCylinder: {
+      const double ua = u.dot(a);
+      const Vector3 radial = u - ua * a;
+      const double rn = radial.norm();
+      return c + 0.5 * sh.length * (ua >= 0.0 ? 1.0 : -1.0) * a + (rn > kTiny ? Vector3(sh.radius / rn * radial) : Vector3::Zero());
+    }
+    case ShapeType::kCapsule: return c + 0.5 * sh.length * (u.dot(a) >= 0.0 ? 1.0 : -1.0) * a + sh.radius * u;
+    case ShapeType::kSphere: return c + sh.radius * u;
+    default: return c;
+  }
+}
+
+bool hasAxis(const ShapeView& s) { return s.shape->type == ShapeType::kCylinder || s.shape->type == ShapeType::kCapsule; }
+
+}  // namespace
+
+bool satPenetration(const ShapeView& x, const ShapeView& y, double& d, Vector3& p1, Vector3& p2) {
+  std::array<Vector3, 32> axes;
+  std::size_t n = 0;
+  const auto dirs = [&](const ShapeView& s, std::array<Vector3, 3>& out) -> int {
+    if (s.shape->type == ShapeType::kBox) {
+      for (int i = 0; i < 3; ++i) out[static_cast<std::size_t>(i)] = s.oMs.R.col(i);
+      return 3;
+    }
+    if (hasAxis(s)) {
+      out[0] = s.oMs.R.col(2);
+      return 1;
+    }
+    return 0;
+  };
+  std::array<Vector3, 3> dx, dy;
+  const int nx = dirs(x, dx), ny = dirs(y, dy);
+  for (int i = 0; i < nx; ++i) axes[n++] = dx[static_cast<std::size_t>(i)];
+  for (int j = 0; j < ny; ++j) axes[n++] = dy[static_cast<std::size_t>(j)];
+  for (int i = 0; i < nx; ++i)
+    for (int j = 0; j < ny; ++j) {
+      const Vector3 c = dx[static_cast<std::size_t>(i)].cross(dy[static_cast<std::size_t>(j)]);
+      if (c.norm() > 1e-9) axes[n++] = c.normalized();
+    }
+  // the line between the cores (closest points of the axes' segments, or the centres)
+  {
+    Vector3 x0, x1, y0, y1, cp, cq;
+    const auto seg = [](const ShapeView& s, Vector3& a, Vector3& b) {
+      const double h = hasAxis(s) ? 0.5 * s.shape->length : 0.0;
+      a = s.oMs.act(Vector3(0, 0, -h));
+      b = s.oMs.act(Vector3(0, 0, h));
+    };
+    seg(x, x0, x1);
+    seg(y, y0, y1);
+    double ss, tt;
+    closestSegmentSegment(x0, x1, y0, y1, ss, tt, cp, cq);
+    if ((cq - cp).norm() > 1e-9) axes[n++] = (cq - cp).normalized();
+    // and from the core of a round shape to its radial direction about the other's axis
+    for (const auto& [a, b] : {std::make_pair(&x, &y), std::make_pair(&y, &x)})
+      if (hasAxis(*a)) {
+        const Vector3 ax = a->oMs.R.col(2);
+        Vector3 r = b->oMs.p - a->oMs.p;
+        r -= r.dot(ax) * ax;
+        if (r.norm() > 1e-9) axes[n++] = r.normalized();
+      }
+  }
+  if (n == 0) axes[n++] = Vector3::UnitZ();  // two spheres at one centre
+  double best = std::numeric_limits<double>::infinity();
+  Vector3 best_u = Vector3::UnitZ();
+  for (std::size_t k = 0; k < n; ++k)
+    for (const double sign : {1.0, -1.0}) {
+      const Vector3 u = sign * axes[k];  // from x to y
+      const double overlap = support(x, u) + support(y, -u);
+      if (overlap < best) {
+        best = overlap;
+        best_u = u;
+      }
+    }
+  if (!(best >= 0.0) || !std::isfinite(best)) return false;  // a separating axis: not overlapping after all
+  d = -best;
+  p1 = supportPoint(x, best_u);      // x's deepest point into y
+  p2 = p1 - best * best_u;           // where it must go to touch y's surface
+  return p1.allFinite() && p2.allFinite();
+}
+
+// Closest points of two convex shapes: libccd's GJK when they are apart (no EPA), else satPenetration().
 template <typename SX, typename SY>
 bool gjk(const ShapeView& x, const ShapeView& y, NarrowScratch& sc, double& d, Vector3& p1, Vector3& p2) {
-  return sc.gjk.shapeSignedDistance(*static_cast<const SX*>(x.geometry), toFcl(x.oMs),
-                                    *static_cast<const SY*>(y.geometry), toFcl(y.oMs), &d, &p1, &p2);
+  if (sc.gjk.shapeDistance(*static_cast<const SX*>(x.geometry), toFcl(x.oMs), *static_cast<const SY*>(y.geometry),
+                           toFcl(y.oMs), &d, &p1, &p2) &&
+      d > 0.0)
+    return true;
+  if (satPenetration(x, y, d, p1, p2)) return true;
+  throw std::runtime_error("collision: GJK found an overlap the axis test does not");  // counted as a failed pair
 }
 
 template <typename SX>

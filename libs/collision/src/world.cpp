@@ -54,6 +54,7 @@ struct Body {
   int mannequin = -1;
   int segment = -1;
   std::vector<int> colliders;
+  std::uint64_t ignored_mannequins = 0;  ///< bit m: no pair with mannequin m's segments (setIgnoresMannequin)
 };
 
 struct MannequinEntry {
@@ -146,6 +147,9 @@ struct CollisionWorld::Impl {
   bool placedPair(int a, int b) const {
     const Body& A = bodies[a];
     const Body& B = bodies[b];
+    if ((B.mannequin >= 0 && B.mannequin < 64 && (A.ignored_mannequins >> B.mannequin & 1u) != 0) ||
+        (A.mannequin >= 0 && A.mannequin < 64 && (B.ignored_mannequins >> A.mannequin & 1u) != 0))
+      return false;  // e.g. a held object and the mannequin holding it: not even a narrow phase
     if (A.mannequin == B.mannequin) return true;
     const auto unplaced = [&](const Body& X, const Body& Y) {
       return X.mannequin >= 0 && !mannequins[X.mannequin].placed && Y.kind != BodyKind::kStatic;
@@ -379,6 +383,20 @@ void CollisionWorld::setMargin(int body, double margin) {
   if (!std::isfinite(margin) || margin < 0.0) throw std::invalid_argument("margin must be finite and >= 0");
   impl_->bodies[body].margin = margin;
   impl_->dirty = true;
+}
+
+void CollisionWorld::setIgnoresMannequin(int body, int mannequin, bool ignore) {
+  if (body < 0 || body >= bodyCount()) throw std::invalid_argument("collision: setIgnoresMannequin: no body " + std::to_string(body));
+  if (mannequin < 0 || mannequin >= mannequinCount() || mannequin >= 64)
+    throw std::invalid_argument("collision: setIgnoresMannequin: no mannequin " + std::to_string(mannequin) + " (at most 64)");
+  std::uint64_t& m = impl_->bodies[static_cast<std::size_t>(body)].ignored_mannequins;
+  const std::uint64_t bit = std::uint64_t{1} << mannequin;
+  m = ignore ? (m | bit) : (m & ~bit);
+}
+
+bool CollisionWorld::ignoresMannequin(int body, int mannequin) const {
+  if (body < 0 || body >= bodyCount() || mannequin < 0 || mannequin >= 64) return false;
+  return (impl_->bodies[static_cast<std::size_t>(body)].ignored_mannequins >> mannequin & 1u) != 0;
 }
 
 void CollisionWorld::query(std::uint64_t step, ContactSet& out) {

@@ -634,12 +634,18 @@ int World::grasp(int m, const std::string& frame, const std::string& object_name
   if (handle < 0) return -1;
   if (static_cast<std::size_t>(handle) >= P.grasp_records.size()) P.grasp_records.resize(static_cast<std::size_t>(handle) + 1);
   P.grasp_records[static_cast<std::size_t>(handle)] = {o, m};
+  // no narrow phase between the held object and its holder (they overlap by design)
+  P.cw.setIgnoresMannequin(P.object_body[static_cast<std::size_t>(o)], P.cw_mannequin[static_cast<std::size_t>(m)], true);
   return handle;
 }
 
 bool World::release(int handle) {
   if (!physics_ || !physics_->grasps || !physics_->grasps->release(handle)) return false;
-  physics_->grasp_records[static_cast<std::size_t>(handle)] = {};
+  Physics& P = *physics_;
+  const Physics::GraspRecord g = P.grasp_records[static_cast<std::size_t>(handle)];
+  P.grasp_records[static_cast<std::size_t>(handle)] = {};
+  if (g.object >= 0 && g.mannequin >= 0 && !P.holds(g.mannequin, g.object))
+    P.cw.setIgnoresMannequin(P.object_body[static_cast<std::size_t>(g.object)], P.cw_mannequin[static_cast<std::size_t>(g.mannequin)], false);
   return true;
 }
 

@@ -91,6 +91,11 @@ class CollisionWorld {
   /// \throws std::invalid_argument for an unknown mannequin.
   void setMannequinPlaced(int mannequin, bool placed);
   bool mannequinPlaced(int mannequin) const;
+  /// Whether `body` pairs with no segment of `mannequin` (true: such pairs are dropped before the narrow
+  /// phase, e.g. an object a hand of that mannequin holds: its shapes sit inside the hand's, where FCL's
+  /// GJK/EPA can abort). \throws std::invalid_argument for an unknown body or mannequin (at most 64).
+  void setIgnoresMannequin(int body, int mannequin, bool ignore);
+  bool ignoresMannequin(int body, int mannequin) const;
   /// Sets a body's margin (m, ≥ 0).
   void setMargin(int body, double margin);
 
