@@ -467,12 +467,10 @@ TEST(CollisionWorld, BadArgumentsThrowClearly) {
   skeleton::Data data(model);
   EXPECT_THROW(w.updateMannequin(5, data), std::invalid_argument);
 }
-// FCL's GJK/EPA (libccd) gives up on two equal boxes 1 nm apart ("the origin is outside of the
-// polytope", a std::logic_error, with Debian's FCL 0.7): the query does not throw, counts the pair as
-// failed, reports no contact for it, and goes on with the other pairs (the box on the floor).
+
 // Two identical boxes at the same pose (1 nm apart): libccd's EPA gave up on this degenerate overlap (the
-// pair used to be counted as failed); FCL's own EPA, which the narrow phase now uses for overlaps, gives
-// the penetration: the boxes must move apart by their smallest width (0.0708 m) plus both margins.
+// pair used to be counted as failed); the separating-axis test the narrow phase now uses for overlaps
+// gives the penetration: the boxes must move apart by their smallest width (0.0708 m) plus both margins.
 TEST(CollisionWorld, CoincidentBoxesGetTheirPenetrationAndTheQueryGoesOn) {
   CollisionWorld w = floorWorld(0.02);
   const double width = 0.070778059122916431312;
@@ -493,6 +491,30 @@ TEST(CollisionWorld, CoincidentBoxesGetTheirPenetrationAndTheQueryGoesOn) {
   }
   EXPECT_NEAR(deepest, -(width + 0.01), 1e-3);
   EXPECT_EQ(floor_c, 4);
+  expectConsistent(w, cs);
+}
+
+// Two crossed cylinders (r = 0.1 m, 1 m long, along z and along x) whose sides overlap by 5 cm: the contact
+// is where they cross — depth 5 cm, normal along y, the witness points on each side at x = z = 0 — not at
+// an end of either axis (every point of an axis perpendicular to the normal is as deep).
+TEST(CollisionWorld, CrossedCylindersOverlappingTouchWhereTheyCross) {
+  WorldOptions o;
+  o.activation_distance = 0.02;
+  CollisionWorld w(o);
+  const int a = w.addBody("a", {{Shape::cylinder(0.1, 1.0), SE3()}}, SE3(), BodyKind::kMovable);
+  const int b = w.addBody("b", {{Shape::cylinder(0.1, 1.0), SE3()}}, SE3(rotY(kPi / 2), Vector3(0, 0.15, 0)), BodyKind::kMovable);
+  ContactSet cs;
+  ASSERT_NO_THROW(w.query(0, cs));
+  EXPECT_EQ(cs.stats.failed_pairs, 0);
+  ASSERT_EQ(cs.contacts.size(), 1u);
+  const Contact& c = cs.contacts[0];
+  ASSERT_EQ(c.body_a, a);
+  ASSERT_EQ(c.body_b, b);
+  EXPECT_NEAR(c.distance, -0.05, 1e-9);
+  EXPECT_NEAR(c.normal.y(), 1.0, 1e-9);
+  const Vector3 pa = w.bodyPose(a).act(c.point_a), pb = w.bodyPose(b).act(c.point_b);
+  EXPECT_LT((pa - Vector3(0, 0.1, 0)).norm(), 1e-9) << pa.transpose();
+  EXPECT_LT((pb - Vector3(0, 0.05, 0)).norm(), 1e-9) << pb.transpose();
   expectConsistent(w, cs);
 }
 

@@ -333,23 +333,34 @@ double support(const ShapeView& s, const Vector3& u) {
   }
 }
 
-Vector3 supportPoint(const ShapeView& s, const Vector3& u) {
+// A point of s farthest along u. Along an axis e of s (a box's, a cylinder's or capsule's) that u is
+// perpendicular to, every coordinate in [−h, h] is as far: the one nearest `toward` (a point of the
+// other shape) is taken, so that an edge or a side touching the other shape gives the contact where they
+// meet, not at an end.
+double alongAxis(const Vector3& u, const Vector3& e, double h, const Vector3& from_centre) {
+  const double ue = u.dot(e);
+  if (std::abs(ue) < 1e-9) return std::clamp(from_centre.dot(e), -h, h);
+  return ue > 0.0 ? h : -h;
+}
+
+Vector3 supportPoint(const ShapeView& s, const Vector3& u, const Vector3& toward) {
   const Vector3 c = s.oMs.p;
   const Vector3 a = s.oMs.R.col(2);
+  const Vector3 rel = toward - c;
   const Shape& sh = *s.shape;
   switch (sh.type) {
     case ShapeType::kBox: {
       Vector3 p = c;
-      for (int i = 0; i < 3; ++i) p += 0.5 * sh.size[i] * (u.dot(s.oMs.R.col(i)) >= 0.0 ? 1.0 : -1.0) * s.oMs.R.col(i);
+      for (int i = 0; i < 3; ++i) p += alongAxis(u, s.oMs.R.col(i), 0.5 * sh.size[i], rel) * s.oMs.R.col(i);
       return p;
     }
     case ShapeType::kCylinder: {
       const double ua = u.dot(a);
       const Vector3 radial = u - ua * a;
       const double rn = radial.norm();
-      return c + 0.5 * sh.length * (ua >= 0.0 ? 1.0 : -1.0) * a + (rn > kTiny ? Vector3(sh.radius / rn * radial) : Vector3::Zero());
+      return c + alongAxis(u, a, 0.5 * sh.length, rel) * a + (rn > kTiny ? Vector3(sh.radius / rn * radial) : Vector3::Zero());
     }
-    case ShapeType::kCapsule: return c + 0.5 * sh.length * (u.dot(a) >= 0.0 ? 1.0 : -1.0) * a + sh.radius * u;
+    case ShapeType::kCapsule: return c + alongAxis(u, a, 0.5 * sh.length, rel) * a + sh.radius * u;
     case ShapeType::kSphere: return c + sh.radius * u;
     default: return c;
   }
@@ -383,8 +394,9 @@ bool satPenetration(const ShapeView& x, const ShapeView& y, double& d, Vector3& 
       if (c.norm() > 1e-9) axes[n++] = c.normalized();
     }
   // the line between the cores (closest points of the axes' segments, or the centres)
+  Vector3 cq = y.oMs.p;
   {
-    Vector3 x0, x1, y0, y1, cp, cq;
+    Vector3 x0, x1, y0, y1, cp;
     const auto seg = [](const ShapeView& s, Vector3& a, Vector3& b) {
       const double h = hasAxis(s) ? 0.5 * s.shape->length : 0.0;
       a = s.oMs.act(Vector3(0, 0, -h));
@@ -416,9 +428,10 @@ bool satPenetration(const ShapeView& x, const ShapeView& y, double& d, Vector3& 
         best_u = u;
       }
     }
-  if (!(best >= 0.0) || !std::isfinite(best)) return false;  // a separating axis: not overlapping after all
+  if (!std::isfinite(best)) return false;
+  // best < 0: a separating axis after all (GJK's "touching" within its tolerance): apart by −best at most
   d = -best;
-  p1 = supportPoint(x, best_u);      // x's deepest point into y
+  p1 = supportPoint(x, best_u, cq);  // x's deepest point into y (ties: nearest y's core)
   p2 = p1 - best * best_u;           // where it must go to touch y's surface
   return p1.allFinite() && p2.allFinite();
 }
@@ -431,7 +444,7 @@ bool gjk(const ShapeView& x, const ShapeView& y, NarrowScratch& sc, double& d, V
       d > 0.0)
     return true;
   if (satPenetration(x, y, d, p1, p2)) return true;
-  throw std::runtime_error("collision: GJK found an overlap the axis test does not");  // counted as a failed pair
+  throw std::runtime_error("collision: no depth for an overlapping pair");  // counted as a failed pair
 }
 
 template <typename SX>

@@ -474,6 +474,18 @@ void World::setScenario(scenario::Scenario sc) {
   run->obs.objects.resize(run->objects.size());
   for (std::size_t k = 0; k < run->objects.size(); ++k) run->obs.objects[k].values.resize(sc.objects[k].values.size());
   run->engine = std::make_unique<scenario::Engine>(std::move(sc));
+  if (scenario_) {
+    // the previous scenario's effects end with it: its mechanisms off, its grasps released, modes free
+    // (gains it set stay)
+    ScenarioRun& S = *scenario_;
+    for (std::size_t i = 0; i < S.frames.size(); ++i) {
+      Mannequin& m = *mannequins_[static_cast<std::size_t>(S.frames[i].mannequin)];
+      if (S.mechanism[i] != nullptr)
+        if (auto* cs = dynamic_cast<ControllerStepper*>(m.stepper.get())) cs->setMechanism(static_cast<int>(S.frames[i].driven), nullptr);
+      if (S.grasp_handle[i] >= 0) release(S.grasp_handle[i]);
+      m.frames[S.frames[i].driven].mode = "free";
+    }
+  }
   scenario_ = std::move(run);
 }
 
@@ -487,7 +499,10 @@ long World::scenarioUnappliedActions() const { return scenario_ ? scenario_->una
 void World::stepScenario() {
   ScenarioRun& S = *scenario_;
   for (const ScenarioRun::Frame& f : S.frames)
-    if (!mannequins_[static_cast<std::size_t>(f.mannequin)]->calibrated) return;  // no targets yet
+    if (!mannequins_[static_cast<std::size_t>(f.mannequin)]->calibrated) {
+      S.pending.clear();  // not running yet: triggers are dropped, not queued for its first step
+      return;
+    }
   scenario::Observation& obs = S.obs;
   obs.time = time();
   for (std::size_t i = 0; i < S.frames.size(); ++i) {
@@ -527,7 +542,9 @@ void World::stepScenario() {
     const bool frame_ok = act.frame >= 0 && static_cast<std::size_t>(act.frame) < S.frames.size();
     if (act.kind == scenario::Action::Kind::kGrasp && frame_ok && act.object >= 0 && physics_) {
       const ScenarioRun::Frame& f = S.frames[static_cast<std::size_t>(act.frame)];
-      S.grasp_handle[static_cast<std::size_t>(act.frame)] =
+      int& held = S.grasp_handle[static_cast<std::size_t>(act.frame)];
+      if (held >= 0) release(held);  // one grasp per frame: a second one replaces the first
+      held =
           grasp(f.mannequin, sc.frames[static_cast<std::size_t>(act.frame)].frame, sc.objects[static_cast<std::size_t>(act.object)].name);
     } else if (act.kind == scenario::Action::Kind::kSetGains && frame_ok) {
       const ScenarioRun::Frame& f = S.frames[static_cast<std::size_t>(act.frame)];

@@ -91,11 +91,12 @@ struct SimService::Impl {
 
   void onTrigger(const v1::Trigger& t) {
     const scenario::Engine& e = *world.scenarioEngine();
-    if (e.scenario().triggerIndex(t.name()) < 0)
+    if (e.scenario().triggerIndex(t.name()) < 0) {
       spdlog::warn("{}: trigger '{}' from {}: scenario '{}' does not declare it (ignored)", config.name, t.name(),
                    t.header().source(), e.scenario().name);
-    else
-      spdlog::info("{}: trigger '{}'{} from {}", config.name, t.name(), t.value().empty() ? "" : " = " + t.value(), t.header().source());
+      return;
+    }
+    spdlog::info("{}: trigger '{}'{} from {}", config.name, t.name(), t.value().empty() ? "" : " = " + t.value(), t.header().source());
     world.trigger(t.name(), t.value());
   }
 

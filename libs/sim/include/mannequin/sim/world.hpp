@@ -313,8 +313,11 @@ class World {
   /// actions call grasp()/release() (physics on), set_gains ControllerStepper::setGains; attach/detach
   /// guide (and set_gains with the kinematic stepper) are counted in scenarioUnappliedActions(), not applied.
   /// \throws std::invalid_argument naming a mannequin, frame, object or value the World lacks.
+  /// A scenario set while another runs replaces it: the old one's mechanisms are disabled, its grasps
+  /// released and its frames' modes set back to free (gains its set_gains changed stay).
   void setScenario(scenario::Scenario s);
-  /// An operator trigger, seen by the scenario at the next step.
+  /// An operator trigger, seen by the scenario at the next step; dropped while the scenario does not run
+  /// yet (its mannequins not calibrated).
   void trigger(const std::string& name, const std::string& value = "");
   /// The engine (state, time in state, context stack), nullptr without a scenario.
   const scenario::Engine* scenarioEngine() const;
