@@ -549,11 +549,14 @@ void World::stepScenario() {
     } else if (act.kind == scenario::Action::Kind::kSetGains && frame_ok) {
       const ScenarioRun::Frame& f = S.frames[static_cast<std::size_t>(act.frame)];
       auto* cs = dynamic_cast<ControllerStepper*>(mannequins_[static_cast<std::size_t>(f.mannequin)]->stepper.get());
-      try {
-        if (cs == nullptr) throw std::invalid_argument("no controller");
-        cs->setGains(static_cast<int>(f.driven), act.stiffness ? &*act.stiffness : nullptr, act.damping ? &*act.damping : nullptr);
-      } catch (const std::invalid_argument&) {
-        ++S.unapplied;  // the kinematic tracker has no gains to set; bad gains are refused at load
+      if (cs == nullptr) {
+        ++S.unapplied;  // the kinematic tracker has no gains to set
+      } else {
+        try {
+          cs->setGains(static_cast<int>(f.driven), act.stiffness ? &*act.stiffness : nullptr, act.damping ? &*act.damping : nullptr);
+        } catch (const std::invalid_argument&) {
+          ++S.unapplied;  // bad gains are refused at load: not expected
+        }
       }
     } else if (act.kind == scenario::Action::Kind::kRelease && frame_ok) {
       int& h = S.grasp_handle[static_cast<std::size_t>(act.frame)];

@@ -185,4 +185,25 @@ void toScenarioState(const scenario::Engine& engine, double sim_time, v1::Scenar
   for (const std::string& s : engine.lastEvents()) out.add_last_events(s);
 }
 
+ScenarioWatch::Tick ScenarioWatch::after(const sim::World& world) {
+  Tick t;
+  const scenario::Engine* e = world.scenarioEngine();
+  if (e == nullptr || e->state() < 0) return t;
+  t.engine = e;
+  t.switched = e->state() != last_state_;
+  t.first = t.switched && last_state_ < 0;
+  last_state_ = e->state();
+  phase_ += per_step_;
+  const bool scheduled = phase_ >= 1.0 - 1e-9;
+  if (scheduled) phase_ -= 1.0;
+  t.publish = scheduled || t.switched;
+  return t;
+}
+
+std::string ScenarioWatch::events(const scenario::Engine& engine) {
+  std::string out;
+  for (const std::string& l : engine.lastEvents()) out += (out.empty() ? "" : "; ") + l;
+  return out;
+}
+
 }  // namespace mannequin::simservice

@@ -243,24 +243,14 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
   TriggerSchedule triggers(config.scenario.triggers);
   v1::ScenarioState state_msg;
   std::uint32_t state_seq = 0;
-  double state_phase = 0.0;
-  int last_state = -1;
+  ScenarioWatch watch(config.scenario.state_rate, config.world.step);
   const auto scenarioAfterStep = [&] {
-    const scenario::Engine* e = world.scenarioEngine();
-    if (e == nullptr || e->state() < 0) return;  // not run yet (mannequins not calibrated)
-    const bool switched = e->state() != last_state;
-    if (switched) {
-      std::string events;
-      if (last_state >= 0)
-        for (const std::string& l : e->lastEvents()) events += (events.empty() ? "" : "; ") + l;
-      s.scenario_timeline.push_back({world.time(), e->stateName(), events});
-      last_state = e->state();
-    }
-    state_phase += config.scenario.state_rate * config.world.step;
-    const bool scheduled = state_phase >= 1.0 - 1e-9;
-    if (scheduled) state_phase -= 1.0;
-    if (!writer || !(scheduled || switched)) return;
-    toScenarioState(*e, world.time(), state_msg);
+    const ScenarioWatch::Tick tick = watch.after(world);
+    if (tick.engine == nullptr) return;
+    const scenario::Engine& e = *tick.engine;
+    if (tick.switched) s.scenario_timeline.push_back({world.time(), e.stateName(), tick.first ? "" : ScenarioWatch::events(e)});
+    if (!writer || !tick.publish) return;
+    toScenarioState(e, world.time(), state_msg);
     v1::Header* h = state_msg.mutable_header();
     h->set_schema_version(transport::kSchemaVersion);
     h->set_sequence(++state_seq);
@@ -371,7 +361,7 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
   if (const scenario::Engine* e = world.scenarioEngine()) {
     s.scenario = e->scenario().name;
     s.scenario_states = static_cast<long long>(e->scenario().states.size());
-    s.scenario_state = last_state >= 0 ? e->stateName() : "";
+    s.scenario_state = e->state() >= 0 ? e->stateName() : "";
     s.scenario_unapplied_actions = world.scenarioUnappliedActions();
   }
   if (const constraints::ConstraintSolver* cs = world.constraintSolver()) s.lcp_failures = cs->failures();

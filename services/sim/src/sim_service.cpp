@@ -63,8 +63,7 @@ struct SimService::Impl {
   // the scenario (config key `scenario`): timed triggers, scenario.state at state_rate and at switches
   TriggerSchedule schedule;
   v1::ScenarioState scenario_msg;
-  double state_phase = 0.0;
-  int last_state = -1;
+  ScenarioWatch watch;
 
   Impl(const SimServiceConfig& c, zmq::context_t& ctx, double hb)
       : config(c),
@@ -72,7 +71,8 @@ struct SimService::Impl {
         pub(ctx, transport::PublisherOptions{c.name, c.publish, 1000, c.mode == Mode::kReplay}),
         sub(ctx, transport::SubscriberOptions{c.name, subscriberEndpoints(c), c.mode == Mode::kReplay ? 100000 : 1000, 10000}),
         health(pub, c.name, &sub, hb),
-        schedule(config.scenario.triggers) {
+        schedule(config.scenario.triggers),
+        watch(config.scenario.state_rate, config.world.step) {
     setupScenario(world, config);
     world_sources = world.mocapSources();
     period.reset(world.numMannequins());
@@ -101,21 +101,16 @@ struct SimService::Impl {
   }
 
   void publishScenario() {
-    const scenario::Engine* e = world.scenarioEngine();
-    if (e == nullptr || e->state() < 0) return;  // not run yet (mannequins not calibrated)
-    const bool switched = e->state() != last_state;
-    if (switched) {
-      std::string events;
-      for (const std::string& l : e->lastEvents()) events += (events.empty() ? "" : "; ") + l;
-      spdlog::info("{}: scenario '{}' at {:.3f} s: state '{}'{}", config.name, e->scenario().name, world.time(), e->stateName(),
-                   last_state < 0 || events.empty() ? "" : " (" + events + ")");
-      last_state = e->state();
+    const ScenarioWatch::Tick tick = watch.after(world);
+    if (tick.engine == nullptr) return;
+    const scenario::Engine& e = *tick.engine;
+    if (tick.switched) {
+      const std::string events = tick.first ? "" : ScenarioWatch::events(e);
+      spdlog::info("{}: scenario '{}' at {:.3f} s: state '{}'{}", config.name, e.scenario().name, world.time(), e.stateName(),
+                   events.empty() ? "" : " (" + events + ")");
     }
-    state_phase += config.scenario.state_rate * config.world.step;
-    const bool scheduled = state_phase >= 1.0 - 1e-9;
-    if (scheduled) state_phase -= 1.0;
-    if (!(scheduled || switched)) return;
-    toScenarioState(*e, world.time(), scenario_msg);
+    if (!tick.publish) return;
+    toScenarioState(e, world.time(), scenario_msg);
     pub.publish(topics::kScenarioState, scenario_msg);
   }
 

@@ -22,4 +22,25 @@ void toCollisionQuery(const sim::World& world, double margin, v1::CollisionQuery
 /// the labels of the transitions fired at the last switch.
 void toScenarioState(const scenario::Engine& engine, double sim_time, v1::ScenarioState& out);
 
+/// Watches the World's scenario after each step (the sim service and mannequin-simulate): whether it
+/// switched state, and whether scenario.state is due (`state_rate` per second of sim time, and at every
+/// switch).
+class ScenarioWatch {
+ public:
+  ScenarioWatch(double state_rate, double step) : per_step_(state_rate * step) {}
+  struct Tick {
+    const scenario::Engine* engine = nullptr;  ///< nullptr: no scenario, or not running yet (not calibrated)
+    bool switched = false;  ///< entered a state this step (the initial one included)
+    bool first = false;     ///< that state is the initial one
+    bool publish = false;   ///< scenario.state is due
+  };
+  Tick after(const sim::World& world);
+  /// The labels of the transitions fired at the engine's last switch, joined by "; ".
+  static std::string events(const scenario::Engine& engine);
+
+ private:
+  double per_step_, phase_ = 0.0;
+  int last_state_ = -1;
+};
+
 }  // namespace mannequin::simservice
