@@ -219,6 +219,40 @@ TEST(Synthetic, HandCheckablePositionsAndOcclusion) {
   EXPECT_TRUE(src.finished());
 }
 
+// Waypoints: rest at each, the minimum-jerk law between (s(½) = ½, s(¼) = 10/64 − 15/256 + 6/1024), the
+// first held before it and the last after it.
+TEST(Synthetic, WaypointsAreJoinedByMinimumJerkSegmentsAndHeldAtTheEnds) {
+  SyntheticOptions o;
+  o.rate_hz = 100;
+  o.paced = false;
+  o.duration = 4.0;
+  SyntheticBody b;
+  b.name = "hand_r";
+  b.waypoints = {{0.5, {0, 0, 1}}, {1.5, {0.4, 0, 1}}, {3.5, {0.4, 0.2, 1.4}}};
+  o.bodies = {b};
+  SyntheticSource src(o);
+  const auto at = [&](std::uint64_t k) { return src.frameAt(k).bodies[0].pose.p; };
+  EXPECT_LT((at(0) - math::Vector3(0, 0, 1)).norm(), 1e-12);    // before the first: held
+  EXPECT_LT((at(50) - math::Vector3(0, 0, 1)).norm(), 1e-12);
+  EXPECT_LT((at(100) - math::Vector3(0.2, 0, 1)).norm(), 1e-12);  // halfway through the first segment
+  const double s14 = 10.0 / 64 - 15.0 / 256 + 6.0 / 1024;           // s(1/4)
+  EXPECT_LT((at(75) - math::Vector3(0.4 * s14, 0, 1)).norm(), 1e-12);
+  EXPECT_LT((at(150) - math::Vector3(0.4, 0, 1)).norm(), 1e-12);  // at rest on the second
+  EXPECT_LT((at(250) - math::Vector3(0.4, 0.1, 1.2)).norm(), 1e-12);
+  EXPECT_LT((at(400) - math::Vector3(0.4, 0.2, 1.4)).norm(), 1e-12);  // after the last: held
+  // at rest at a waypoint: the speed there is 0 (one sample either side differs by O(dt³))
+  EXPECT_LT((at(151) - at(149)).norm(), 1e-5);
+  SyntheticBody bad = b;
+  bad.waypoints[2].t = 1.5;
+  o.bodies = {bad};
+  try {
+    SyntheticSource s2(o);
+    ADD_FAILURE() << "waypoints not increasing in time accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'hand_r' waypoint 2"), std::string::npos) << e.what();
+  }
+}
+
 TEST(MocapConfig, ShippedFilesAreFoundFromAnotherWorkingDirectory) {
   const std::filesystem::path old = std::filesystem::current_path();
   std::filesystem::current_path(std::filesystem::temp_directory_path());
@@ -293,6 +327,12 @@ TEST(MocapConfig, BuildsSourcesAndNamesFileLineAndField) {
               "test.yaml:5: field 'bvh.rate'");
   expectError("source: synthetic\nsynthetic:\n  rate_hz: abc\n  bodies: []\n", "field 'synthetic.rate_hz': 'abc' is not a number");
   expectError("source: synthetic\nsynthetic:\n  bodies:\n    - {name: a, center: [0, 0]}\n", "expected [x, y, z]");
+  expectError("source: synthetic\nsynthetic:\n  bodies:\n    - {name: a, center: [0, 0, 1], waypoints: [{t: 0, xyz: [0, 0, 1]}]}\n",
+              "field 'synthetic.bodies[0].center': 'center' and 'waypoints' exclude each other");
+  expectError("source: synthetic\nsynthetic:\n  bodies:\n    - name: a\n      waypoints:\n        - {t: 1, xyz: [0, 0, 1]}\n"
+              "        - {t: 0.5, xyz: [0, 0, 1]}\n",
+              "test.yaml:7: field 'synthetic.bodies[0].waypoints[1].t': waypoint times must increase");
+  expectError("source: synthetic\nsynthetic:\n  bodies:\n    - {name: a, waypoints: [{t: 0, at: [0, 0, 1]}]}\n", "unknown key");
   expectError("source: dtrack2\ndtrack2:\n  port: 99999\n  bodies: {0: head}\n", "field 'dtrack2.port'");
   expectError("source: c3d\nc3d:\n  file: data/c3d/sample01_Eb015pr.c3d\n  mapping: configs/mappings/nothing.yaml\n",
               "test.yaml:4: field 'c3d.mapping': configs/mappings/nothing.yaml: not found");

@@ -14,6 +14,7 @@ const char* rowSourceName(RowSource s) {
     case RowSource::kBalance: return "balance";
     case RowSource::kGrasp: return "grasp";
     case RowSource::kHinge: return "hinge";
+    case RowSource::kGuide: return "guide";
     case RowSource::kOther: return "other";
   }
   return "other";

@@ -121,9 +121,22 @@ std::unique_ptr<Source> makeSynthetic(const ConfigNode& c) {
   o.duration = c.getIn("duration", 0.0, 0.0, 1e7);
   o.paced = c.get("paced", true);
   for (const ConfigNode& b : c["bodies"].items()) {
-    b.allowOnly({"name", "center", "amplitude", "frequency", "phase", "rotation_vector", "yaw_rate"});
+    b.allowOnly({"name", "center", "amplitude", "frequency", "phase", "waypoints", "rotation_vector", "yaw_rate"});
     SyntheticBody s;
     s.name = b["name"].str();
+    if (const auto wp = b.find("waypoints")) {
+      for (const char* k : {"center", "amplitude", "frequency", "phase"})
+        if (b.has(k)) b[k].fail(std::string("'") + k + "' and 'waypoints' exclude each other");
+      const auto items = wp->items();
+      if (items.empty()) wp->fail("expected at least one waypoint {t, xyz}");
+      for (const ConfigNode& w : items) {
+        w.allowOnly({"t", "xyz"});
+        const Waypoint p{w["t"].num(), w["xyz"].vec3()};
+        if (!s.waypoints.empty() && !(p.t > s.waypoints.back().t)) w["t"].fail("waypoint times must increase");
+        if (!(p.t >= 0)) w["t"].fail("must be >= 0 s");
+        s.waypoints.push_back(p);
+      }
+    }
     if (b.has("center")) s.center = b["center"].vec3();
     if (b.has("amplitude")) s.amplitude = b["amplitude"].vec3();
     s.frequency = b.getIn("frequency", 0.0, 0.0, 1000.0);

@@ -13,6 +13,15 @@ namespace mannequin::mocap {
 SyntheticSource::SyntheticSource(SyntheticOptions options) : options_(std::move(options)) {
   if (!(options_.rate_hz > 0)) throw std::invalid_argument("synthetic: rate_hz must be > 0");
   if (options_.bodies.empty()) throw std::invalid_argument("synthetic: no bodies");
+  for (const SyntheticBody& b : options_.bodies)
+    for (std::size_t i = 0; i < b.waypoints.size(); ++i) {
+      const Waypoint& w = b.waypoints[i];
+      if (!std::isfinite(w.t) || !w.p.allFinite() || w.t < 0)
+        throw std::invalid_argument("synthetic: body '" + b.name + "' waypoint " + std::to_string(i) + " is not finite or before 0 s");
+      if (i > 0 && !(w.t > b.waypoints[i - 1].t))
+        throw std::invalid_argument("synthetic: body '" + b.name + "' waypoint " + std::to_string(i) + " at " + fmt::format("{}", w.t) +
+                                    " s is not after the previous one");
+    }
   for (const Occlusion& o : options_.occlusions) {
     bool known = false;
     for (const auto& b : options_.bodies) known = known || b.name == o.body;
@@ -36,8 +45,21 @@ Frame SyntheticSource::frameAt(std::uint64_t k) const {
     Body b;
     b.name = sb.name;
     b.id = static_cast<int>(i);
-    const double w = 2 * M_PI * sb.frequency * t + sb.phase;
-    b.pose.p = sb.center + sb.amplitude * std::sin(w);
+    if (sb.waypoints.empty()) {
+      const double w = 2 * M_PI * sb.frequency * t + sb.phase;
+      b.pose.p = sb.center + sb.amplitude * std::sin(w);
+    } else {
+      const std::vector<Waypoint>& W = sb.waypoints;
+      std::size_t i = 0;
+      while (i + 1 < W.size() && t >= W[i + 1].t) ++i;
+      if (i + 1 == W.size() || t <= W[i].t) {
+        b.pose.p = W[i].p;  // before the first (i = 0) or after the last
+      } else {
+        const double tau = (t - W[i].t) / (W[i + 1].t - W[i].t);
+        const double s = tau * tau * tau * (10 - 15 * tau + 6 * tau * tau);
+        b.pose.p = W[i].p + s * (W[i + 1].p - W[i].p);
+      }
+    }
     b.pose.R = math::expSO3(math::Vector3(0, 0, sb.yaw_rate * t)) * sb.orientation;
     for (const Occlusion& o : options_.occlusions)
       if (o.body == sb.name && t >= o.from && t < o.to) b.tracked = false;

@@ -292,9 +292,8 @@ class Reader {
         if (const auto o = a.find("object")) act.object = objectRef(*o);
         break;
       case Action::Kind::kAttachGuide:
-        a.allowOnly({"object", "frame", "mechanism"});
+        a.allowOnly({"object", "mechanism"});
         act.object = objectRef(a["object"]);
-        if (const auto f = a.find("frame")) act.frame = frameRef(*f);
         act.mechanism = control::parseMechanismConfig(a["mechanism"]);
         break;
       case Action::Kind::kDetachGuide:

@@ -88,6 +88,7 @@ struct World::Physics {
   std::vector<int> object_body;                        // per object: collision body id
   std::unique_ptr<HingeLimitRows> hinges;
   std::unique_ptr<GraspRows> grasps;
+  std::unique_ptr<GuideRows> guides;
   struct GraspRecord {
     int object = -1, mannequin = -1;                   // −1: free slot
   };
@@ -335,6 +336,8 @@ void World::buildPhysics() {
     P.solver->addProducer(P.hinges.get());
   }
   if (!P.objects.empty()) {
+    P.guides = std::make_unique<GuideRows>(all_objects, object_systems);
+    P.solver->addProducer(P.guides.get());
     P.grasps = std::make_unique<GraspRows>(std::move(all_objects), std::move(object_systems), max_nv);
     P.solver->addProducer(P.grasps.get());
     P.grasp_records.assign(8, {});  // GraspRows' default max_grasps
@@ -425,6 +428,7 @@ struct World::ScenarioRun {
   std::vector<Frame> frames;       // per scenario frame
   std::vector<int> objects;        // per scenario object: the World's object index
   std::vector<int> grasp_handle;   // per scenario frame: its grasp (−1: none)
+  std::vector<char> guided;        // per scenario object: 1 while a guide it attached holds it
   std::vector<const control::MechanismConfig*> mechanism;  // per scenario frame: the one its controller runs (into the engine's scenario)
   std::vector<scenario::Trigger> pending;
   scenario::Observation obs;
@@ -468,6 +472,18 @@ void World::setScenario(scenario::Scenario sc) {
                                     "': the World reports only 'angle', of hinged objects");
     run->objects.push_back(k);
   }
+  // guides on objects: what the World's GuideRows cannot take is refused now, not at the action
+  for (const scenario::State& st : sc.states)
+    for (const std::vector<scenario::Action>* list : {&st.entry, &st.exit})
+      for (const scenario::Action& a : *list) {
+        if (a.kind != scenario::Action::Kind::kAttachGuide || a.object < 0 || !a.mechanism) continue;
+        const std::string& on = sc.objects[static_cast<std::size_t>(a.object)].name;
+        std::string why;
+        if (object(run->objects[static_cast<std::size_t>(a.object)]).hinged()) why = "a hinged object is guided by its hinge already";
+        else GuideRows::supports(a.mechanism->spec, &why);
+        if (!why.empty()) throw std::invalid_argument(where + ": " + a.where + ": attach_guide on '" + on + "': " + why);
+      }
+  run->guided.assign(run->objects.size(), 0);
   run->grasp_handle.assign(run->frames.size(), -1);
   run->mechanism.assign(run->frames.size(), nullptr);
   run->obs.frames.resize(run->frames.size());
@@ -485,6 +501,8 @@ void World::setScenario(scenario::Scenario sc) {
       if (S.grasp_handle[i] >= 0) release(S.grasp_handle[i]);
       m.frames[S.frames[i].driven].mode = "free";
     }
+    for (std::size_t k = 0; k < S.objects.size(); ++k)
+      if (S.guided[k]) detachGuide(S.objects[k]);
   }
   scenario_ = std::move(run);
 }
@@ -558,6 +576,18 @@ void World::stepScenario() {
           ++S.unapplied;  // bad gains are refused at load: not expected
         }
       }
+    } else if (act.kind == scenario::Action::Kind::kAttachGuide && act.object >= 0 && act.mechanism && physics_) {
+      const std::size_t k = static_cast<std::size_t>(act.object);
+      try {
+        attachGuide(S.objects[k], act.mechanism->spec);
+        S.guided[k] = 1;
+      } catch (const std::invalid_argument&) {
+        ++S.unapplied;  // validated at setScenario: not expected
+      }
+    } else if (act.kind == scenario::Action::Kind::kDetachGuide && act.object >= 0 && physics_) {
+      const std::size_t k = static_cast<std::size_t>(act.object);
+      detachGuide(S.objects[k]);  // a guide already off is not an error: the state asked for it off
+      S.guided[k] = 0;
     } else if (act.kind == scenario::Action::Kind::kRelease && frame_ok) {
       int& h = S.grasp_handle[static_cast<std::size_t>(act.frame)];
       if (h >= 0) release(h);
@@ -680,6 +710,15 @@ math::Vector3 World::graspForce(int handle) const {
     return math::Vector3::Zero();
   return physics_->grasps->force(handle);
 }
+
+void World::attachGuide(int i, const control::MechanismSpec& spec) {
+  if (!physics_ || !physics_->guides) throw std::invalid_argument("sim: a guide needs physics and a scene with objects");
+  physics_->guides->attach(i, spec);
+}
+
+bool World::detachGuide(int i) { return physics_ && physics_->guides && physics_->guides->detach(i); }
+
+const GuideRows* World::guides() const { return physics_ ? physics_->guides.get() : nullptr; }
 
 const std::string& World::name(int m) const { return mannequins_.at(m)->name; }
 const skeleton::Model& World::model(int m) const { return mannequins_.at(m)->model; }

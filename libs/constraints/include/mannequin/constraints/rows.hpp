@@ -13,7 +13,7 @@
 ///
 /// Row kinds:
 /// - kUnilateral: 0 ≤ d̂/δt ⊥ λ ≥ 0 (contact normals, joint limits, swing/twist, balance);
-/// - kBilateral: d̂ = 0, λ free (grasps, hinges): split by the solver into two unilateral rows;
+/// - kBilateral: d̂ = 0, λ free (grasps, guides on objects): split by the solver into two unilateral rows;
 /// - friction: a unilateral row with friction_edges > 0 and mu > 0 gets a linearised Coulomb cone
 ///   of `friction_edges` directions t_k = cos(2πk/m) t1 + sin(2πk/m) t2 (t1, t2 ⟂ the normal, given
 ///   by the producer as tangent Jacobians), in the same LCP (Stewart–Trinkle form: edge forces
@@ -33,7 +33,7 @@ namespace mannequin::constraints {
 enum class RowKind : std::uint8_t { kUnilateral, kBilateral };
 
 /// What produced a row (diagnostics, sim.world).
-enum class RowSource : std::uint8_t { kJointLimit, kSwing, kTwist, kContact, kBalance, kGrasp, kHinge, kOther };
+enum class RowSource : std::uint8_t { kJointLimit, kSwing, kTwist, kContact, kBalance, kGrasp, kHinge, kGuide, kOther };
 const char* rowSourceName(RowSource s);
 
 /// One row's data besides its Jacobians.

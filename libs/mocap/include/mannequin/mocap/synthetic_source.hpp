@@ -1,8 +1,10 @@
 #pragma once
 /// \file synthetic_source.hpp
-/// \brief Scripted trajectories for tests: each body moves as p(t) = center + amplitude ∘ sin(2π f t + phase)
-/// (component-wise) with a constant orientation, or rotates about z at `yaw_rate`; bodies can be occluded
-/// over time windows.
+/// \brief Scripted trajectories (tests, scripted actors of the demonstrations): each body moves as
+/// p(t) = center + amplitude ∘ sin(2π f t + phase) (component-wise), or through WAYPOINTS: from one to the
+/// next along a straight line with the minimum-jerk time law s(τ) = 10τ³ − 15τ⁴ + 6τ⁵ (τ the fraction of
+/// the segment's time; the body rests at each waypoint), holding the first before it and the last after
+/// it. Orientation constant, or rotating about z at `yaw_rate`; bodies can be occluded over time windows.
 #include <string>
 #include <vector>
 
@@ -10,8 +12,14 @@
 
 namespace mannequin::mocap {
 
+struct Waypoint {
+  double t = 0.0;                             ///< s of capture time
+  math::Vector3 p = math::Vector3::Zero();   ///< m, room frame
+};
+
 struct SyntheticBody {
   std::string name;
+  std::vector<Waypoint> waypoints;                  ///< non-empty: replaces center/amplitude (times increasing)
   math::Vector3 center = math::Vector3::Zero();     ///< m, room frame
   math::Vector3 amplitude = math::Vector3::Zero();  ///< m
   double frequency = 0.0;                           ///< Hz
@@ -35,7 +43,8 @@ struct SyntheticOptions {
 
 class SyntheticSource final : public Source {
  public:
-  /// \throws std::invalid_argument for a rate <= 0 or no bodies.
+  /// \throws std::invalid_argument for a rate <= 0, no bodies, waypoints not strictly increasing in time
+  /// or not finite (naming the body).
   explicit SyntheticSource(SyntheticOptions options);
   std::optional<Frame> next(std::chrono::microseconds timeout) override;
   bool finished() const override { return finished_; }

@@ -62,7 +62,7 @@ struct ModeSpec {
 struct Action {
   enum class Kind { kGrasp, kRelease, kAttachGuide, kDetachGuide, kSetGains };
   Kind kind = Kind::kGrasp;
-  int frame = -1;     ///< control frame index (grasp, release, set_gains; attach_guide: optional)
+  int frame = -1;     ///< control frame index (grasp, release, set_gains)
   int object = -1;    ///< object index (grasp, release: optional, attach/detach_guide)
   std::optional<control::MechanismConfig> mechanism;  ///< attach_guide
   std::optional<Vector6> stiffness, damping;          ///< set_gains (rotation xyz, translation xyz)

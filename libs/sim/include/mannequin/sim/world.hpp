@@ -39,8 +39,9 @@
 #include "mannequin/constraints/joint_limits.hpp"
 #include "mannequin/constraints/solver.hpp"
 #include "mannequin/sim/mocap_buffer.hpp"
-#include "mannequin/sim/rigid_object.hpp"
 #include "mannequin/control/config.hpp"
+#include "mannequin/sim/object_guides.hpp"
+#include "mannequin/sim/rigid_object.hpp"
 #include "mannequin/sim/stepper.hpp"
 #include "mannequin/sim/tracker.hpp"
 #include "mannequin/skeleton/model.hpp"
@@ -297,11 +298,6 @@ class World {
   int findObject(const std::string& name) const;
   /// Collision body id of object i.
   int objectBody(int i) const;
-  /// Grasps object `object` with the body carrying `frame` of mannequin `m` (e.g. "palm_l", "hand_r") at
-  /// their current relative pose (thesis 4.3.1: bilateral rows until release). Contacts between the
-  /// object and that mannequin's segments are ignored while held. Returns a handle ≥ 0, or −1 when the
-  /// object is already held by this frame's body or every grasp slot is used.
-  /// \throws std::invalid_argument naming an unknown mannequin, frame or object, or physics off.
   /// Runs a scenario's state machine in the loop (thesis 4.1.2, libs/scenario): every step, once all its
   /// mannequins are calibrated, its engine sees the commanded control frames (simulated pose, mocap target;
   /// force: the normal forces of the last step's contacts on the segments the frame carries — its own and
@@ -310,11 +306,13 @@ class World {
   /// the mechanism; autonomous: the trajectory — velocity-continuous across switches (their world twist
   /// fed forward as the targets' body twist); a constrained mode also runs its virtual mechanism in the
   /// controller (ControllerStepper::setMechanism, from the switch until the mode changes). Its grasp/release
-  /// actions call grasp()/release() (physics on), set_gains ControllerStepper::setGains; attach/detach
-  /// guide (and set_gains with the kinematic stepper) are counted in scenarioUnappliedActions(), not applied.
-  /// \throws std::invalid_argument naming a mannequin, frame, object or value the World lacks.
+  /// actions call grasp()/release() (physics on), set_gains ControllerStepper::setGains, attach_guide /
+  /// detach_guide attachGuide()/detachGuide(); set_gains with the kinematic stepper is counted in
+  /// scenarioUnappliedActions(), not applied.
+  /// \throws std::invalid_argument naming a mannequin, frame, object or value the World lacks, or a guide
+  /// an object cannot take (GuideRows::supports; a hinged object).
   /// A scenario set while another runs replaces it: the old one's mechanisms are disabled, its grasps
-  /// released and its frames' modes set back to free (gains its set_gains changed stay).
+  /// released, its guides detached and its frames' modes set back to free (gains its set_gains changed stay).
   void setScenario(scenario::Scenario s);
   /// An operator trigger, seen by the scenario at the next step; dropped while the scenario does not run
   /// yet (its mannequins not calibrated).
@@ -322,6 +320,11 @@ class World {
   /// The engine (state, time in state, context stack), nullptr without a scenario.
   const scenario::Engine* scenarioEngine() const;
   long scenarioUnappliedActions() const;
+  /// Grasps object `object` with the body carrying `frame` of mannequin `m` (e.g. "palm_l", "hand_r") at
+  /// their current relative pose (thesis 4.3.1: bilateral rows until release). Contacts between the
+  /// object and that mannequin's segments are ignored while held. Returns a handle ≥ 0, or −1 when the
+  /// object is already held by this frame's body or every grasp slot is used.
+  /// \throws std::invalid_argument naming an unknown mannequin, frame or object, or physics off.
   int grasp(int m, const std::string& frame, const std::string& object);
   /// Releases a grasp; false for an unknown handle.
   bool release(int handle);
@@ -330,6 +333,15 @@ class World {
   /// Force (N, world) the grasp `handle` applied on its object at the last step (the hand gets the
   /// opposite); zero for an unknown handle.
   math::Vector3 graspForce(int handle) const;
+  /// Guides object i on a virtual mechanism (object_guides.hpp: rows of the LCP on the object alone,
+  /// thesis 4.3.1: a tray kept level, a part kept on an axis), replacing a guide it had.
+  /// \throws std::invalid_argument on physics off, an unknown object, a hinged object or a spec
+  /// GuideRows::supports refuses (a curve, coordinate forces, bad stops), naming the object and why.
+  void attachGuide(int i, const control::MechanismSpec& spec);
+  /// Ends object i's guide; false if it had none (or physics is off).
+  bool detachGuide(int i);
+  /// Object i's guide (nullptr with physics off or without objects): its coordinates, errors and force.
+  const GuideRows* guides() const;
 
  private:
   struct Mannequin;
