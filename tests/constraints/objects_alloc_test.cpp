@@ -3,8 +3,12 @@
 // balance distance, one LCP, integration) allocates nothing after warm-up.
 #include <gtest/gtest.h>
 
+#include <cmath>
+#include <limits>
+
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/control/config.hpp"
+#include "mannequin/sim/object_guides.hpp"
 #include "mannequin/sim/rigid_object.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
@@ -31,6 +35,16 @@ TEST(RigidObjectAlloc, StagesAndProducersAllocateNothing) {
   cs::RowSet rows({6, 1, 6}, 32, 8, 4);
   sim::HingeLimitRows limits({{&lever, 1}});
   sim::GraspRows grasps({&ball, &lever}, {0, 1}, 6);
+  // a guide on the "hand" object: a sliding pivot with stops 1 cm either side (two tilt rows, two position
+  // rows, both stops within its 0.5 m activation: the unconstrained test motion drifts a few cm)
+  sim::GuideRows guides({&ball, &lever, &hand}, {0, 1, 2}, 0.5);
+  mannequin::control::MechanismSpec pivot;
+  pivot.type = mannequin::control::MechanismType::kSlidingPivot;
+  pivot.base = hand.pose();
+  pivot.lower = Eigen::Vector2d(-0.01, -std::numeric_limits<double>::infinity());
+  pivot.upper = Eigen::Vector2d(0.01, std::numeric_limits<double>::infinity());
+  guides.attach(2, pivot);
+  double guide_error = 0;
   const Eigen::VectorXd g6 = Eigen::VectorXd::Constant(6, 0.1), g1 = Eigen::VectorXd::Constant(1, 0.1);
   const Vector3 gravity(0, 0, -9.81);
   int handle = grasps.grasp({2, &hand, 0}, 0);
@@ -42,6 +56,9 @@ TEST(RigidObjectAlloc, StagesAndProducersAllocateNothing) {
     limits.addRows(0, 0.001, rows);
     grasps.addRows(1, 0.001, rows);
     grasps.solved(1, rows);
+    guides.addRows(2, 0.001, rows);
+    guides.solved(2, rows);
+    guide_error += guides.positionError(2) + guides.angleError(2) + guides.coordinates(2)(0);
     ball.applyConstraintForce(g6);
     hand.applyConstraintForce(g6);
     lever.applyConstraintForce(g1);
@@ -55,7 +72,10 @@ TEST(RigidObjectAlloc, StagesAndProducersAllocateNothing) {
   });
   if (n < 0) GTEST_SKIP() << "allocations not counted under AddressSanitizer";
   EXPECT_EQ(n, 0);
-  EXPECT_EQ(rows.size(), 6 + 2);  // the grasp's six rows and both limits of the lever (±0.1 rad, within 0.2)
+  // the grasp's six rows, both limits of the lever (±0.1 rad, within 0.2), the guide's two position, two tilt
+  // and two stop rows
+  EXPECT_EQ(rows.size(), 6 + 2 + 6);
+  EXPECT_TRUE(std::isfinite(guide_error));
 }
 
 TEST(WorldAlloc, APhysicsStepAllocatesNothingAfterWarmUp) {

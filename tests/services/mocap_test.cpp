@@ -219,8 +219,8 @@ TEST(Synthetic, HandCheckablePositionsAndOcclusion) {
   EXPECT_TRUE(src.finished());
 }
 
-// Waypoints: rest at each, the minimum-jerk law between (s(½) = ½, s(¼) = 10/64 − 15/256 + 6/1024), the
-// first held before it and the last after it.
+// Waypoints: rest at each, the minimum-jerk law between (s(½) = ½, s(¼) = 10/64 − 15/256 + 6/1024) for the
+// position and the orientation, the first held before it and the last after it.
 TEST(Synthetic, WaypointsAreJoinedByMinimumJerkSegmentsAndHeldAtTheEnds) {
   SyntheticOptions o;
   o.rate_hz = 100;
@@ -228,7 +228,7 @@ TEST(Synthetic, WaypointsAreJoinedByMinimumJerkSegmentsAndHeldAtTheEnds) {
   o.duration = 4.0;
   SyntheticBody b;
   b.name = "hand_r";
-  b.waypoints = {{0.5, {0, 0, 1}}, {1.5, {0.4, 0, 1}}, {3.5, {0.4, 0.2, 1.4}}};
+  b.waypoints = {{0.5, {0, 0, 1}}, {1.5, {0.4, 0, 1}}, {3.5, {0.4, 0.2, 1.4}, math::expSO3(math::Vector3(0, -1.2, 0))}};
   o.bodies = {b};
   SyntheticSource src(o);
   const auto at = [&](std::uint64_t k) { return src.frameAt(k).bodies[0].pose.p; };
@@ -240,6 +240,10 @@ TEST(Synthetic, WaypointsAreJoinedByMinimumJerkSegmentsAndHeldAtTheEnds) {
   EXPECT_LT((at(150) - math::Vector3(0.4, 0, 1)).norm(), 1e-12);  // at rest on the second
   EXPECT_LT((at(250) - math::Vector3(0.4, 0.1, 1.2)).norm(), 1e-12);
   EXPECT_LT((at(400) - math::Vector3(0.4, 0.2, 1.4)).norm(), 1e-12);  // after the last: held
+  // the orientation turns with the same law: half of the 1.2 rad about −y halfway, all of it at the end
+  EXPECT_LT((src.frameAt(150).bodies[0].pose.R - math::Matrix3::Identity()).norm(), 1e-12);
+  EXPECT_LT((src.frameAt(250).bodies[0].pose.R - math::expSO3(math::Vector3(0, -0.6, 0))).norm(), 1e-12);
+  EXPECT_LT((src.frameAt(400).bodies[0].pose.R - math::expSO3(math::Vector3(0, -1.2, 0))).norm(), 1e-12);
   // at rest at a waypoint: the speed there is 0 (one sample either side differs by O(dt³))
   EXPECT_LT((at(151) - at(149)).norm(), 1e-5);
   SyntheticBody bad = b;

@@ -779,3 +779,72 @@ TEST(WorldScenario, AConstrainedModeGuidesTheHandOnTheMechanismsAxisAndSetGainsR
   EXPECT_STREQ(hand.mode, "free");
   EXPECT_LT((hand.actual.p - moved).norm(), 0.02);
 }
+
+// Guides on objects through the scenario (attach_guide / detach_guide, World::attachGuide): a 1 kg tray
+// in the air, no one holding it, is kept level and at its height by a plane guide (its weight carried by the
+// guide) and pushed sideways by 3 N slides in its plane; the trigger 'drop' detaches the guide and it falls.
+// A scenario whose guide the World cannot apply (a curve, a hinged object) is refused naming its line.
+TEST(WorldScenario, AttachGuideHoldsATrayLevelAndDetachGuideLetsItFall) {
+  const char* scene =
+      "bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"
+      "  - name: tray\n    movable: true\n    pose: {position: [0.8, 0.4, 1.0]}\n    mass: 1.0\n"
+      "    inertia: [0.01, 0.02, 0.03]\n    shape: {type: box, size: [0.4, 0.3, 0.02]}\n"
+      "  - name: door\n    movable: true\n    pose: {position: [2.0, 0, 1.0]}\n    mass: 10\n"
+      "    hinge: {axis: [0, 0, 1], point: [2.0, 0.45, 0], limits_deg: [0, 90]}\n    shape: {type: box, size: [0.04, 0.9, 2.0]}\n";
+  std::vector<MannequinSetup> setups;
+  setups.push_back(actorSetup("operator", ""));
+  World w(std::move(setups), physicsConfig(scene));
+  const int tray = w.findObject("tray");
+  ASSERT_GE(tray, 0);
+  const std::string head = "scenario: tray\nmannequins:\n  - name: operator\n    frames: [hand_r]\nobjects: [tray, door]\n";
+  w.setScenario(scenario::parseScenario(
+      head + "triggers: [drop]\ninitial: level\nstates:\n  - name: level\n    modes: {hand_r: free}\n    entry:\n"
+             "      - attach_guide: {object: tray, mechanism: {type: plane, origin: {xyz: [0.8, 0.4, 1.0]}}}\n"
+             "    transitions:\n      - {to: fall, when: {trigger: drop}}\n"
+             "  - name: fall\n    modes: {hand_r: free}\n    entry:\n      - detach_guide: {object: tray}\n",
+      "tray.yaml"));
+  const math::SE3 base = placed(0, 0, 0);
+  w.addMocap(actorFrame(0, base));
+  w.anchor(0);
+  const auto feed = [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base)); };
+  double worst_tilt = 0, worst_height = 0;
+  w.object(tray).addForce(w.object(tray).pose().p, math::Vector3(3, 0, 0));
+  ASSERT_TRUE(run(w, 0, 1.0, feed, [&](double t) {
+    w.object(tray).addForce(w.object(tray).pose().p, math::Vector3(3, 0, 0));  // for the next step
+    if (t > 0.01) {
+      worst_tilt = std::max(worst_tilt, std::acos(std::clamp(w.object(tray).pose().R(2, 2), -1.0, 1.0)));
+      worst_height = std::max(worst_height, std::abs(w.object(tray).pose().p.z() - 1.0));
+    }
+    return true;
+  }));
+  const GuideRows* g = w.guides();
+  ASSERT_NE(g, nullptr);
+  EXPECT_TRUE(g->guided(tray));
+  const double slid = w.object(tray).pose().p.x() - 0.8;
+  std::printf("guided tray: tilt %.2e rad, height off %.2e m, slid %.4f m in 1 s, guide force z %.4f N (m g = 9.81)\n",
+              worst_tilt, worst_height, slid, g->force(tray).z());
+  EXPECT_LT(worst_tilt, 1e-6);
+  EXPECT_LT(worst_height, 1e-6);
+  EXPECT_NEAR(slid, 3.0 * 0.05 / 1.0, 0.005);       // in its plane at F τ / m = 0.15 m/s (τ = 0.05 s)
+  EXPECT_NEAR(g->force(tray).z(), 9.81, 0.01);      // the guide carries its weight
+  EXPECT_EQ(w.scenarioUnappliedActions(), 0);
+  w.trigger("drop");
+  ASSERT_TRUE(run(w, 1.0, 0.5, feed));
+  EXPECT_EQ(w.scenarioEngine()->stateName(), "fall");
+  EXPECT_FALSE(g->guided(tray));
+  EXPECT_LT(w.object(tray).pose().p.z(), 1.0 - 0.1);  // falling at g τ (0.49 m/s)
+  // guides the World cannot apply are refused at setScenario, naming the action's line
+  const auto refused = [&](const std::string& action, const std::string& what) {
+    try {
+      w.setScenario(scenario::parseScenario(head + "initial: a\nstates:\n  - name: a\n    modes: {hand_r: free}\n    entry:\n" + action,
+                                            "bad.yaml"));
+      ADD_FAILURE() << "accepted: " << action;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("bad.yaml:"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  refused("      - attach_guide: {object: tray, mechanism: {type: curve, points: [[0, 0, 1], [1, 0, 1]]}}\n", "curve");
+  refused("      - attach_guide: {object: door, mechanism: {type: prismatic}}\n", "hinged");
+  refused("      - attach_guide: {object: tray, mechanism: {type: plane, normal_force: 5}}\n", "force");
+}

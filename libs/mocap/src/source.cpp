@@ -130,8 +130,12 @@ std::unique_ptr<Source> makeSynthetic(const ConfigNode& c) {
       const auto items = wp->items();
       if (items.empty()) wp->fail("expected at least one waypoint {t, xyz}");
       for (const ConfigNode& w : items) {
-        w.allowOnly({"t", "xyz"});
-        const Waypoint p{w["t"].num(), w["xyz"].vec3()};
+        w.allowOnly({"t", "xyz", "rotation_vector"});
+        // orientation: its own, else the previous waypoint's, else the body's
+        const math::Matrix3 R = w.has("rotation_vector") ? orientationOf(w)
+                                : s.waypoints.empty()    ? orientationOf(b)
+                                                         : s.waypoints.back().R;
+        const Waypoint p{w["t"].num(), w["xyz"].vec3(), R};
         if (!s.waypoints.empty() && !(p.t > s.waypoints.back().t)) w["t"].fail("waypoint times must increase");
         if (!(p.t >= 0)) w["t"].fail("must be >= 0 s");
         s.waypoints.push_back(p);

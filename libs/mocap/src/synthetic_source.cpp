@@ -61,6 +61,18 @@ Frame SyntheticSource::frameAt(std::uint64_t k) const {
       }
     }
     b.pose.R = math::expSO3(math::Vector3(0, 0, sb.yaw_rate * t)) * sb.orientation;
+    if (!sb.waypoints.empty()) {
+      const std::vector<Waypoint>& W = sb.waypoints;
+      std::size_t i = 0;
+      while (i + 1 < W.size() && t >= W[i + 1].t) ++i;
+      if (i + 1 == W.size() || t <= W[i].t) {
+        b.pose.R = W[i].R;
+      } else {
+        const double tau = (t - W[i].t) / (W[i + 1].t - W[i].t);
+        const double s = tau * tau * tau * (10 - 15 * tau + 6 * tau * tau);
+        b.pose.R = W[i].R * math::expSO3(s * math::logSO3(W[i].R.transpose() * W[i + 1].R));
+      }
+    }
     for (const Occlusion& o : options_.occlusions)
       if (o.body == sb.name && t >= o.from && t < o.to) b.tracked = false;
     if (!b.tracked) b.quality = 0.0;

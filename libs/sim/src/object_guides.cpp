@@ -204,20 +204,20 @@ void GuideRows::addRows(int id, double /*dt*/, constraints::RowSet& rows) {
     if (type != MechanismType::kPlane)
       for (int i = 0; i < 2; ++i) {
         const int r = add(i, constraints::RowKind::kBilateral, m.r(i));
-        if (r >= 0) rows.jacobian(r, sys) = oMb.R.col(i).transpose() * Jp_.leftCols(nv);
+        if (r >= 0) rows.jacobian(r, sys).noalias() = oMb.R.col(i).transpose() * Jp_.leftCols(nv);
       }
     if (type == MechanismType::kPrismatic) {
       // R_o = R_b: e = log(R_o R_bᵀ), ė = J_l⁻¹(e) ω (world ω: a left perturbation)
       const Matrix3 Jli = math::leftJacobianInverseSO3(m.rot_err);
       for (int i = 0; i < 3; ++i) {
         const int r = add(kRotation + i, constraints::RowKind::kBilateral, m.rot_err(i));
-        if (r >= 0) rows.jacobian(r, sys) = Jli.row(i) * Jw_.leftCols(nv);
+        if (r >= 0) rows.jacobian(r, sys).noalias() = Jli.row(i) * Jw_.leftCols(nv);
       }
     } else {
       const Matrix3 A = -hat(oMb.R.col(2)) * hat(obj.pose(0).R.col(2));  // ∂(z_b × z_o)/∂ω
       for (int i = 0; i < 2; ++i) {  // z_o = z_b: the tilts about the base's x and y axes
         const int r = add(kTilt + i, constraints::RowKind::kBilateral, oMb.R.col(i).dot(m.tilt));
-        if (r >= 0) rows.jacobian(r, sys) = (oMb.R.col(i).transpose() * A) * Jw_.leftCols(nv);
+        if (r >= 0) rows.jacobian(r, sys).noalias() = (oMb.R.col(i).transpose() * A) * Jw_.leftCols(nv);
       }
     }
     // the coordinates' stops
@@ -231,9 +231,9 @@ void GuideRows::addRows(int id, double /*dt*/, constraints::RowSet& rows) {
       const auto rate = [&](int r, double sign) {
         if (r < 0) return;
         if (axis < 0)
-          rows.jacobian(r, sys) = sign * (dir.transpose() * Jw_.leftCols(nv));
+          rows.jacobian(r, sys).noalias() = sign * (dir.transpose() * Jw_.leftCols(nv));
         else
-          rows.jacobian(r, sys) = sign * (dir.transpose() * Jp_.leftCols(nv));
+          rows.jacobian(r, sys).noalias() = sign * (dir.transpose() * Jp_.leftCols(nv));
       };
       if (lo == hi) {
         rate(add(kStops + 2 * c, constraints::RowKind::kBilateral, s - lo), 1.0);

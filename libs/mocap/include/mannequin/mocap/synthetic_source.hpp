@@ -4,7 +4,9 @@
 /// p(t) = center + amplitude ∘ sin(2π f t + phase) (component-wise), or through WAYPOINTS: from one to the
 /// next along a straight line with the minimum-jerk time law s(τ) = 10τ³ − 15τ⁴ + 6τ⁵ (τ the fraction of
 /// the segment's time; the body rests at each waypoint), holding the first before it and the last after
-/// it. Orientation constant, or rotating about z at `yaw_rate`; bodies can be occluded over time windows.
+/// it; the orientation turns from one waypoint's to the next's along the geodesic, R_i exp(s log(R_iᵀ R_i+1)).
+/// Otherwise the orientation is constant, or rotating about z at `yaw_rate`. Bodies can be occluded over
+/// time windows.
 #include <string>
 #include <vector>
 
@@ -15,6 +17,7 @@ namespace mannequin::mocap {
 struct Waypoint {
   double t = 0.0;                             ///< s of capture time
   math::Vector3 p = math::Vector3::Zero();   ///< m, room frame
+  math::Matrix3 R = math::Matrix3::Identity();  ///< orientation (room frame), reached with the same time law
 };
 
 struct SyntheticBody {
