@@ -11,17 +11,9 @@
 
 #include "mannequin/scenario/engine.hpp"
 #include "mannequin/simservice/offline.hpp"
+#include "timeline.hpp"
 
 using namespace mannequin;
-
-namespace {
-
-struct Span {
-  std::string state;
-  double from = 0, to = 0;
-};
-
-}  // namespace
 
 // The claims: the lever reaches its end stop (45° from idle, held there by its limit), with no NaN step; and
 // what the figure shows — besides the hand on the lever, many secondary contacts (seat, backrest, armrest,
@@ -31,7 +23,7 @@ TEST(Demo, Fig414PilotPushesTheThrottleToItsEndStopWithManySecondaryContacts) {
   o.config = "configs/sim/sim_pilot.yaml";
   simservice::OfflineRun run(o);
   const bool verbose = std::getenv("MANNEQUIN_DEMO_VERBOSE") != nullptr;
-  std::vector<Span> spans;
+  demo_test::Timeline timeline;
   int lever = -1;
   double max_angle = 0, upper = 0, next_print = 0;
   double worst_step_s = 0, constraint_s = 0;
@@ -63,9 +55,8 @@ TEST(Demo, Fig414PilotPushesTheThrottleToItsEndStopWithManySecondaryContacts) {
       std::printf("       lever %.2f deg, contacts %d (active %d), step %.0f us\n", w.object(lever).angle() * 180 / M_PI, d.contacts,
                   d.active_contacts, step_s * 1e6);
     }
+    timeline.see(e, w.time());
     if (e == nullptr || e->state() < 0) return;
-    if (spans.empty() || spans.back().state != e->stateName()) spans.push_back({e->stateName(), w.time(), w.time()});
-    spans.back().to = w.time();
     most_contacts = std::max(most_contacts, d.active_contacts);
     if (e->stateName() == "at_stop") ++at_stop_steps;
     // seated (after sitting down, 4 s): the contacts that carry the pilot, other than the lever
@@ -85,19 +76,13 @@ TEST(Demo, Fig414PilotPushesTheThrottleToItsEndStopWithManySecondaryContacts) {
       ++seated_contact_steps;
     }
   });
-  std::string timeline;
-  for (const Span& sp : spans) timeline += sp.state + " [" + std::to_string(sp.from) + ", " + std::to_string(sp.to) + "] ";
   std::printf("pilot: %s| lever max %.3f deg (end stop %.3f deg), %ld steps at the stop; seated: at least %d loaded contacts "
               "with the seat and floor, carrying at least %.1f N upwards; most active contacts %d; step: mean %.1f us "
               "(constraints %.1f us), worst %.0f us; NaN steps %lld, %.1f s wall\n",
-              timeline.c_str(), max_angle * 180 / M_PI, upper * 180 / M_PI, at_stop_steps, fewest_seated_contacts, seat_force_min,
+              timeline.str().c_str(), max_angle * 180 / M_PI, upper * 180 / M_PI, at_stop_steps, fewest_seated_contacts, seat_force_min,
               most_contacts, s.wall_s / static_cast<double>(std::max(1L, steps)) * 1e6, constraint_s / static_cast<double>(std::max(1L, steps)) * 1e6,
               worst_step_s * 1e6, s.nan_steps, s.wall_s);
-  ASSERT_EQ(spans.size(), 4u) << timeline;
-  EXPECT_EQ(spans[0].state, "seated");
-  EXPECT_EQ(spans[1].state, "grip");
-  EXPECT_EQ(spans[2].state, "at_stop");
-  EXPECT_EQ(spans[3].state, "released");
+  EXPECT_EQ(timeline.states(), (std::vector<std::string>{"seated", "grip", "at_stop", "released"})) << timeline.str();
   EXPECT_EQ(s.scenario_unapplied_actions, 0);
   EXPECT_NEAR(max_angle, upper, 0.5 * M_PI / 180);  // at its end stop, not past it
   EXPECT_GE(at_stop_steps, 900);

@@ -13,15 +13,11 @@
 #include "mannequin/scenario/engine.hpp"
 #include "mannequin/sim/object_guides.hpp"
 #include "mannequin/simservice/offline.hpp"
+#include "timeline.hpp"
 
 using namespace mannequin;
 
 namespace {
-
-struct Span {
-  std::string state;
-  double from = 0, to = 0;
-};
 
 double angleDeg(const math::Matrix3& a, const math::Matrix3& b) { return math::logSO3(a.transpose() * b).norm() * 180.0 / M_PI; }
 
@@ -40,7 +36,7 @@ TEST(Demo, Fig415RotorThePartAndThePinEndInTheirSeatsWithin1mmAnd1Degree) {
   // centre on the hole's axis, upright
   const math::SE3 part_seat(math::expSO3(math::Vector3(-M_PI / 2, 0, 0)), math::Vector3(0.50, 0.08, 1.03));
   const math::SE3 pin_seat(math::Matrix3::Identity(), math::Vector3(0.50, 0.15, 1.03));
-  std::vector<Span> spans;
+  demo_test::Timeline timeline;
   int part = -1, pin = -1;
   double closest_to_blades = 1.0;  // m, after margins
   double segment_margin = 0;
@@ -77,18 +73,17 @@ TEST(Demo, Fig415RotorThePartAndThePinEndInTheirSeatsWithin1mmAnd1Degree) {
         if (c.distance < -0.005)
           std::printf("%7.3f penetration: %s - %s distance %.4f at (%.3f %.3f %.3f)\n", w.time(), w.collisionWorld()->bodyName(c.body_a).c_str(),
                       w.collisionWorld()->bodyName(c.body_b).c_str(), c.distance, c.point.x(), c.point.y(), c.point.z());
+    timeline.see(e, w.time());
     if (e == nullptr || e->state() < 0) return;
     // not the real geometry's penetration from the start: before the first grasp the objects overlap the hips
     // for a few milliseconds (configs/scenes/rotor_blades.yaml)
     // (and after the release the hand and the handle it gripped part: they overlapped while held). What is
     // asserted: nothing is pushed into the blades — the closest approach of any body to them, after margins.
-    if (!spans.empty() && w.time() > spans.front().from + 0.05) {
+    if (w.time() > timeline.spans().front().from + 0.05) {
       for (const sim::ContactReport& c : w.contacts())
         if (w.collisionWorld()->bodyName(c.body_a) == "scene/blades" || w.collisionWorld()->bodyName(c.body_b) == "scene/blades")
           closest_to_blades = std::min(closest_to_blades, c.distance);
     }
-    if (spans.empty() || spans.back().state != e->stateName()) spans.push_back({e->stateName(), w.time(), w.time()});
-    spans.back().to = w.time();
     const sim::GuideRows* g = w.guides();
     ASSERT_NE(g, nullptr);
     if (g->guided(part) && e->timeInState() > 0.5) {
@@ -105,21 +100,14 @@ TEST(Demo, Fig415RotorThePartAndThePinEndInTheirSeatsWithin1mmAnd1Degree) {
       for (const sim::DrivenFrame& f : w.controlFrames(0))
         if (f.frame == "hand_r") target_off_m = std::max(target_off_m, (f.target.p - f.actual.p).norm());
   });
-  std::string timeline;
-  for (const Span& sp : spans) timeline += sp.state + " [" + std::to_string(sp.from) + ", " + std::to_string(sp.to) + "] ";
   const double part_m = (part_end.p - part_seat.p).norm(), part_deg = angleDeg(part_end.R, part_seat.R);
   const double pin_m = (pin_end.p - pin_seat.p).norm(), pin_deg = angleDeg(pin_end.R, pin_seat.R);
   std::printf("rotor: %s| part ends %.2e m / %.3f deg from its seat (guided %ld steps: %.2e m / %.3f deg off its line); pin "
               "ends %.2e m / %.3f deg from its seat (guided %ld steps: %.2e m / %.3f deg); the right hand's target up to %.3f m "
               "from the hand while the pin goes in; NaN steps %lld, failed pairs %ld, closest to the blades %.4f m (after margins; max penetration of the run %.4f m), %.1f s wall\n",
-              timeline.c_str(), part_m, part_deg, part_guided, part_off_m, part_off_deg, pin_m, pin_deg, pin_guided, pin_off_m,
+              timeline.str().c_str(), part_m, part_deg, part_guided, part_off_m, part_off_deg, pin_m, pin_deg, pin_guided, pin_off_m,
               pin_off_deg, target_off_m, s.nan_steps, failed_pairs, closest_to_blades, s.max_penetration_m, s.wall_s);
-  ASSERT_EQ(spans.size(), 5u) << timeline;
-  EXPECT_EQ(spans[0].state, "carry");
-  EXPECT_EQ(spans[1].state, "insert");
-  EXPECT_EQ(spans[2].state, "seated");
-  EXPECT_EQ(spans[3].state, "pin");
-  EXPECT_EQ(spans[4].state, "done");
+  EXPECT_EQ(timeline.states(), (std::vector<std::string>{"carry", "insert", "seated", "pin", "done"})) << timeline.str();
   EXPECT_EQ(s.scenario_unapplied_actions, 0);
   EXPECT_LT(part_m, 0.001);
   EXPECT_LT(part_deg, 1.0);

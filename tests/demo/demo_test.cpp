@@ -9,17 +9,11 @@
 
 #include "mannequin/scenario/engine.hpp"
 #include "mannequin/simservice/offline.hpp"
+#include "timeline.hpp"
 
 using namespace mannequin;
 
-namespace {
-
-struct StateSpan {
-  std::string state;
-  double from = 0, to = 0;
-};
-
-}  // namespace
+using demo_test::Timeline;
 
 // Demonstration 1, Fig. 4.8: a jump with six control frames (feet, hands, pelvis, head all free, the
 // CMU capture 131_03). The scenario names the phases from the floor's push on the feet; the claim: both
@@ -29,7 +23,7 @@ TEST(Demo, Fig48JumpWithSixControlFramesBothFeetLeaveTheFloorAndLandWithoutPenet
   o.config = "configs/sim/sim_demo.yaml";
   o.scenario = "configs/scenarios/jump.yaml";
   simservice::OfflineRun run(o);
-  std::vector<StateSpan> spans;
+  Timeline timeline;
   double lowest_sole = 1e9, margin = -1, w_step = 0;
   long airborne_steps = 0, airborne_feet_touching = 0, flight = 0, longest_flight = 0;
   bool standing_at_end = false;
@@ -40,9 +34,8 @@ TEST(Demo, Fig48JumpWithSixControlFramesBothFeetLeaveTheFloorAndLandWithoutPenet
     const scenario::Engine* e = w.scenarioEngine();
     ASSERT_NE(e, nullptr);
     const sim::MannequinDiagnostics& d = w.mannequinDiagnostics(0);
+    timeline.see(e, w.time());
     if (e->state() >= 0) {
-      if (spans.empty() || spans.back().state != e->stateName()) spans.push_back({e->stateName(), w.time(), w.time()});
-      spans.back().to = w.time();
       if (e->stateName() == "standing" && e->timeInState() < 0.5)
         for (const sim::DrivenFrame& f : w.controlFrames(0))
           if (f.frame == "foot_l" || f.frame == "foot_r") standing_ankle = std::max(standing_ankle, f.actual.p.z());
@@ -56,15 +49,10 @@ TEST(Demo, Fig48JumpWithSixControlFramesBothFeetLeaveTheFloorAndLandWithoutPenet
     if (w.calibrated(0)) lowest_sole = std::min(lowest_sole, d.sole_height_m);
     standing_at_end = d.foot_contact;
   });
-  std::string timeline;
-  for (const StateSpan& sp : spans) timeline += sp.state + " [" + std::to_string(sp.from) + ", " + std::to_string(sp.to) + "] ";
   std::printf("jump: %s| airborne %ld steps (a foot within touching distance in %ld, longest flight %ld steps), lowest sole "
               "%.4f m (margin %.3f), NaN steps %lld, ankles standing at most %.3f m\n",
-              timeline.c_str(), airborne_steps, airborne_feet_touching, longest_flight, lowest_sole, margin, s.nan_steps, standing_ankle);
-  ASSERT_EQ(spans.size(), 3u) << timeline;
-  EXPECT_EQ(spans[0].state, "standing");
-  EXPECT_EQ(spans[1].state, "airborne");
-  EXPECT_EQ(spans[2].state, "landed");
+              timeline.str().c_str(), airborne_steps, airborne_feet_touching, longest_flight, lowest_sole, margin, s.nan_steps, standing_ankle);
+  EXPECT_EQ(timeline.states(), (std::vector<std::string>{"standing", "airborne", "landed"})) << timeline.str();
   // a flight, not a contact flicker: more than 0.1 s with neither foot within touching distance of the floor
   // (foot_contact_tolerance; the scenario's 'landed' waits for 50 N, so the last steps before it may touch)
   EXPECT_GT(static_cast<double>(longest_flight) * w_step, 0.1);
@@ -86,7 +74,7 @@ TEST(Demo, Fig412DrillingTheDrillStaysOnTheHolesAxisAndTheTorchOnTheHole) {
   o.config = "configs/sim/sim_drill.yaml";
   simservice::OfflineRun run(o);
   const math::Vector3 hole(0.6, -0.2, 1.2), hole_axis = math::Vector3::UnitX();
-  std::vector<StateSpan> spans;
+  Timeline timeline;
   double worst_axis_deg = 0, worst_beam_m = 0, worst_tip_m = 0;
   long guided_steps = 0, failed_pairs = 0;
   int drill = -1, torch = -1;
@@ -97,9 +85,8 @@ TEST(Demo, Fig412DrillingTheDrillStaysOnTheHolesAxisAndTheTorchOnTheHole) {
     }
     failed_pairs += w.diagnostics().failed_collision_pairs;  // narrow phases that gave up (the bit meets the wall)
     const scenario::Engine* e = w.scenarioEngine();
+    timeline.see(e, w.time());
     if (e == nullptr || e->state() < 0) return;
-    if (spans.empty() || spans.back().state != e->stateName()) spans.push_back({e->stateName(), w.time(), w.time()});
-    spans.back().to = w.time();
     if (e->stateName() != "guided" || e->timeInState() < 0.5) return;
     ++guided_steps;
     const math::SE3& d = w.object(drill).pose();
@@ -112,16 +99,10 @@ TEST(Demo, Fig412DrillingTheDrillStaysOnTheHolesAxisAndTheTorchOnTheHole) {
     worst_beam_m = std::max(worst_beam_m, (to_hole - to_hole.dot(beam) * beam).norm());
     worst_tip_m = std::max(worst_tip_m, (drill_to_hole - drill_to_hole.dot(hole_axis) * hole_axis).norm());
   });
-  std::string timeline;
-  for (const StateSpan& sp : spans) timeline += sp.state + " [" + std::to_string(sp.from) + ", " + std::to_string(sp.to) + "] ";
   std::printf("drilling: %s| guided %ld steps: drill axis within %.3f deg of the hole's, its origin %.4f m off the axis; "
               "torch beam %.4f m from the hole; NaN steps %lld, %.1f s wall\n",
-              timeline.c_str(), guided_steps, worst_axis_deg, worst_tip_m, worst_beam_m, s.nan_steps, s.wall_s);
-  ASSERT_EQ(spans.size(), 4u) << timeline;
-  EXPECT_EQ(spans[0].state, "grab");
-  EXPECT_EQ(spans[1].state, "guided");
-  EXPECT_EQ(spans[2].state, "retract");
-  EXPECT_EQ(spans[3].state, "done");
+              timeline.str().c_str(), guided_steps, worst_axis_deg, worst_tip_m, worst_beam_m, s.nan_steps, s.wall_s);
+  EXPECT_EQ(timeline.states(), (std::vector<std::string>{"grab", "guided", "retract", "done"})) << timeline.str();
   EXPECT_GE(guided_steps, 1900);  // 2.5 s at depth, measured after the 0.5 s blend
   EXPECT_EQ(s.scenario_unapplied_actions, 0);
   EXPECT_LT(worst_axis_deg, 1.0);
