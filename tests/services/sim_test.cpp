@@ -17,6 +17,9 @@
 #include "mannequin/transport/convert.hpp"
 #include "mannequin/transport/publisher.hpp"
 #include "mannequin/transport/subscriber.hpp"
+#include "mannequin/transport/topics.hpp"
+#include "../common/child_process.hpp"
+#include "../common/tool_run.hpp"
 
 using namespace mannequin;
 using namespace mannequin::sim;
@@ -524,4 +527,44 @@ TEST(SimConfig, ScenarioErrorsNameTheFileLineAndWhat) {
   expectError("scenario: {file: configs/scenarios/drill.yaml, trigers: []}\n", "unknown key");
   // the World lacks what the scenario names: the drill scenario's mannequin 'worker'
   expectError("scenario: configs/scenarios/drill.yaml\n", "no mannequin 'worker'");
+}
+
+// mannequin-trigger, the operator's trigger on a live deployment (docs/scenario.md): it binds its endpoint,
+// waits until a subscriber to scenario.trigger connects (as the sim does), sends the trigger once and
+// exits 0; with nobody subscribing it exits 1 after --wait, saying so; a trigger the sim would refuse is a
+// bad command line (exit 2) naming why.
+TEST(TriggerTool, SendsOnceToASubscriberAndRefusesBadTriggers) {
+  namespace fs = std::filesystem;
+  const fs::path tool = testutil::binDir() / "mannequin-trigger";
+  ASSERT_TRUE(fs::exists(tool)) << tool;
+  const std::string dir = tempDir();
+  const std::string endpoint = "ipc://" + dir + "/trigger";
+  testutil::Child child({tool.string(), "go", "--value", "3", "--publish", endpoint, "--wait", "30"}, dir + "/trigger.log");
+  ASSERT_TRUE(child.started());
+  zmq::context_t context(1);
+  transport::SubscriberOptions so;
+  so.name = "sim";
+  transport::Subscriber sub(context, so);
+  std::vector<v1::Trigger> got;
+  sub.subscribe(transport::topics::kScenarioTrigger, [&](const v1::Trigger& t) { got.push_back(t); });
+  // the tool may not have bound yet: ZeroMQ connects to an ipc endpoint once it exists
+  sub.connect(endpoint);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  while (got.empty() && std::chrono::steady_clock::now() < deadline) sub.poll(std::chrono::milliseconds(50));
+  ASSERT_EQ(got.size(), 1u) << "no trigger within 30 s";
+  EXPECT_EQ(got[0].name(), "go");
+  EXPECT_EQ(got[0].value(), "3");
+  EXPECT_EQ(got[0].header().source(), "trigger");
+  EXPECT_EQ(child.wait(std::chrono::seconds(30)), 0);
+  // sent once: nothing more arrives (the tool has exited)
+  sub.poll(std::chrono::milliseconds(100));
+  EXPECT_EQ(got.size(), 1u);
+  // nobody subscribes: exit 1 after --wait
+  const testutil::ToolResult none = testutil::runTool(tool.string() + " go --publish ipc://" + dir + "/nobody --wait 0.3", 30);
+  EXPECT_EQ(none.exit_code, 1) << none.err;
+  EXPECT_NE(none.err.find("nobody subscribed to scenario.trigger"), std::string::npos) << none.err;
+  // a name the sim refuses (over 128 characters): a bad command line, before anything is bound
+  const testutil::ToolResult bad = testutil::runTool(tool.string() + " " + std::string(200, 'x') + " --wait 0.3", 30);
+  EXPECT_EQ(bad.exit_code, 2) << bad.err;
+  EXPECT_NE(bad.err.find("at most 128"), std::string::npos) << bad.err;
 }

@@ -318,3 +318,31 @@ TEST(PubSub, LatestOnlyKeepsTheNewestOfEachSource) {
   EXPECT_EQ(c.received, 2 * step);
   EXPECT_EQ(c.delivered + c.superseded, 2 * step);
 }
+
+// Publisher::subscribed: a publisher sees which topics its subscribers asked for (mannequin-trigger waits for
+// the sim's scenario.trigger subscription before it sends); a negative linger is refused.
+TEST(PubSub, ThePublisherSeesWhichTopicsAreSubscribed) {
+  TempDir dir;
+  zmq::context_t ctx;
+  Publisher pub(ctx, {"trigger", {dir.ipc("trigger")}});
+  EXPECT_FALSE(pub.subscribed("scenario.trigger"));
+  Subscriber sub(ctx, {"sim", {dir.ipc("trigger")}});
+  std::vector<v1::Trigger> got;
+  sub.subscribe(topics::kScenarioTrigger, collect(got));
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (!pub.subscribed("scenario.trigger") && std::chrono::steady_clock::now() < deadline) {
+    pub.poll();
+    sub.poll(std::chrono::milliseconds(2));
+  }
+  ASSERT_TRUE(pub.subscribed("scenario.trigger")) << "no subscription within 5 s";
+  EXPECT_FALSE(pub.subscribed("sim.world"));  // only what was asked for
+  // once subscribed, a message sent is received
+  v1::Trigger t;
+  t.set_name("go");
+  pub.publish(topics::kScenarioTrigger, t);
+  for (int k = 0; k < 1000 && got.empty(); ++k) sub.poll(std::chrono::milliseconds(5));
+  ASSERT_EQ(got.size(), 1u);
+  PublisherOptions bad{"x", {dir.ipc("bad")}};
+  bad.linger_ms = -1;
+  EXPECT_THROW(Publisher(ctx, bad), std::invalid_argument);
+}

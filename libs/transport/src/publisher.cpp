@@ -2,6 +2,7 @@
 
 #include <spdlog/spdlog.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <stdexcept>
 
@@ -36,7 +37,8 @@ Publisher::Publisher(zmq::context_t& context, PublisherOptions options)
     : options_(std::move(options)), socket_(context, zmq::socket_type::xpub) {
   if (options_.endpoints.empty()) throw std::invalid_argument("publisher '" + options_.source + "': no endpoint to bind");
   socket_.set(zmq::sockopt::sndhwm, options_.send_hwm);
-  socket_.set(zmq::sockopt::linger, 0);
+  if (options_.linger_ms < 0) throw std::invalid_argument("publisher '" + options_.source + "': linger_ms must be >= 0");
+  socket_.set(zmq::sockopt::linger, options_.linger_ms);
   socket_.set(zmq::sockopt::xpub_verbose, 1);
   if (options_.curve) {
     const CurveServerOptions& c = *options_.curve;
@@ -113,6 +115,7 @@ int Publisher::poll() {
     if (msg.size() < 1 || data[0] != 1) continue;  // unsubscribe (0) or garbage
     ++subscriptions_;
     const std::string_view prefix(data + 1, msg.size() - 1);
+    if (std::find(prefixes_.begin(), prefixes_.end(), prefix) == prefixes_.end()) prefixes_.emplace_back(prefix);
     for (auto& [name, s] : topics_) {
       if (!s.latched || !s.has_last || name.compare(0, prefix.size(), prefix) != 0) continue;
       send(name, s.last);
@@ -120,6 +123,12 @@ int Publisher::poll() {
     }
   }
   return n;
+}
+
+bool Publisher::subscribed(std::string_view topic) const {
+  for (const std::string& p : prefixes_)
+    if (topic.substr(0, p.size()) == p) return true;
+  return false;
 }
 
 std::vector<TopicCounters> Publisher::counters() const {

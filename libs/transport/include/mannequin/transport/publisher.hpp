@@ -37,6 +37,9 @@ struct PublisherOptions {
   int send_hwm = 1000;                  ///< messages queued per subscriber before dropping
   bool deterministic = false;           ///< Header.send_time_ns = 0 (byte-identical output in replay)
   std::optional<CurveServerOptions> curve = std::nullopt;  ///< CURVE server with a ZAP key check (unset: plaintext)
+  /// On close, how long (ms) messages still queued may be sent: 0 drops them (services: a restart must not
+  /// wait); a one-shot tool that publishes then exits sets it (mannequin-trigger).
+  int linger_ms = 0;
 };
 
 namespace detail {
@@ -71,6 +74,8 @@ class Publisher {
   std::vector<TopicCounters> counters() const;
   /// Number of subscriptions seen (subscribe messages, including repeats).
   std::uint64_t subscriptions() const { return subscriptions_; }
+  /// Whether a subscription seen by poll() matches `topic` (its prefix): a subscriber would receive it.
+  bool subscribed(std::string_view topic) const;
   /// CURVE: client handshakes refused (key not listed) and admitted by the ZAP handler (0 without CURVE).
   std::uint64_t curveRefusals() const;
   std::uint64_t curveAdmissions() const;
@@ -93,6 +98,7 @@ class Publisher {
   };
   std::unordered_map<std::string, TopicState> topics_;
   std::uint64_t subscriptions_ = 0;
+  std::vector<std::string> prefixes_;  // subscription prefixes seen (subscribed())
 
   TopicState& state(std::string_view topic);
   void send(std::string_view topic, std::string_view payload);
