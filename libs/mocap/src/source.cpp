@@ -121,7 +121,7 @@ std::unique_ptr<Source> makeSynthetic(const ConfigNode& c) {
   o.duration = c.getIn("duration", 0.0, 0.0, 1e7);
   o.paced = c.get("paced", true);
   for (const ConfigNode& b : c["bodies"].items()) {
-    b.allowOnly({"name", "center", "amplitude", "frequency", "phase", "rotation_vector", "yaw_rate"});
+    b.allowOnly({"name", "center", "amplitude", "frequency", "phase", "rotation_vector", "yaw_rate", "keys"});
     SyntheticBody s;
     s.name = b["name"].str();
     if (b.has("center")) s.center = b["center"].vec3();
@@ -130,6 +130,13 @@ std::unique_ptr<Source> makeSynthetic(const ConfigNode& c) {
     s.phase = b.get("phase", 0.0);
     s.orientation = orientationOf(b);
     s.yaw_rate = b.get("yaw_rate", 0.0);
+    if (auto keys = b.find("keys"))
+      for (const ConfigNode& k : keys->items()) {  // [t, dx, dy, dz]
+        const std::vector<ConfigNode> v = k.items();
+        if (v.size() != 4) k.fail("a key is [time s, dx, dy, dz]");
+        if (!s.keys.empty() && !(v[0].num() > s.keys.back().first)) v[0].fail("key times must increase");
+        s.keys.emplace_back(v[0].num(), math::Vector3(v[1].num(), v[2].num(), v[3].num()));
+      }
     o.bodies.push_back(s);
   }
   if (auto occ = c.find("occlusions"))

@@ -10,9 +10,24 @@
 
 namespace mannequin::mocap {
 
+math::Vector3 keyOffset(const std::vector<std::pair<double, math::Vector3>>& keys, double t) {
+  if (keys.empty()) return math::Vector3::Zero();
+  if (t <= keys.front().first) return keys.front().second;
+  for (std::size_t i = 1; i < keys.size(); ++i)
+    if (t < keys[i].first) {
+      const double s = (t - keys[i - 1].first) / (keys[i].first - keys[i - 1].first);
+      return keys[i - 1].second + s * s * (3 - 2 * s) * (keys[i].second - keys[i - 1].second);
+    }
+  return keys.back().second;
+}
+
 SyntheticSource::SyntheticSource(SyntheticOptions options) : options_(std::move(options)) {
   if (!(options_.rate_hz > 0)) throw std::invalid_argument("synthetic: rate_hz must be > 0");
   if (options_.bodies.empty()) throw std::invalid_argument("synthetic: no bodies");
+  for (const SyntheticBody& b : options_.bodies)
+    for (std::size_t i = 1; i < b.keys.size(); ++i)
+      if (!(b.keys[i].first > b.keys[i - 1].first))
+        throw std::invalid_argument("synthetic: body '" + b.name + "': key times must increase");
   for (const Occlusion& o : options_.occlusions) {
     bool known = false;
     for (const auto& b : options_.bodies) known = known || b.name == o.body;
@@ -37,7 +52,7 @@ Frame SyntheticSource::frameAt(std::uint64_t k) const {
     b.name = sb.name;
     b.id = static_cast<int>(i);
     const double w = 2 * M_PI * sb.frequency * t + sb.phase;
-    b.pose.p = sb.center + sb.amplitude * std::sin(w);
+    b.pose.p = sb.center + sb.amplitude * std::sin(w) + keyOffset(sb.keys, t);
     b.pose.R = math::expSO3(math::Vector3(0, 0, sb.yaw_rate * t)) * sb.orientation;
     for (const Occlusion& o : options_.occlusions)
       if (o.body == sb.name && t >= o.from && t < o.to) b.tracked = false;

@@ -2,8 +2,10 @@
 /// \file synthetic_source.hpp
 /// \brief Scripted trajectories for tests: each body moves as p(t) = center + amplitude ∘ sin(2π f t + phase)
 /// (component-wise) with a constant orientation, or rotates about z at `yaw_rate`; bodies can be occluded
-/// over time windows.
+/// over time windows. Key frames (`keys`) add a scripted offset: the offset of the last key at or before t,
+/// eased (smoothstep) towards the next key's; the first key's offset before it, the last's after it.
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "mannequin/mocap/source.hpp"
@@ -18,7 +20,12 @@ struct SyntheticBody {
   double phase = 0.0;                               ///< rad
   math::Matrix3 orientation = math::Matrix3::Identity();
   double yaw_rate = 0.0;                            ///< rad/s about the room z axis
+  /// (time s, offset m) key frames added to the position, times strictly increasing; empty: none.
+  std::vector<std::pair<double, math::Vector3>> keys;
 };
+
+/// The key frames' offset at time t (zero without keys).
+math::Vector3 keyOffset(const std::vector<std::pair<double, math::Vector3>>& keys, double t);
 
 struct Occlusion {
   std::string body;
