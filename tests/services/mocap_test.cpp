@@ -270,6 +270,34 @@ TEST(MocapConfig, TheShippedC3dConfigStreamsTheMarkerClustersAsBodies) {
   EXPECT_GT(tracked, frames / 2);
 }
 
+// Key frames (`keys: [[t, dx, dy, dz], ...]`): the offset added to the body's position holds the first key's
+// before it, eases (smoothstep) between keys — half way at the middle — and holds the last one's after it.
+TEST(MocapConfig, SyntheticKeyFramesOffsetTheBodyEasedBetweenKeys) {
+  auto src = makeSource(configOf("source: synthetic\nsynthetic:\n  rate_hz: 100\n  bodies:\n"
+                                 "    - {name: a, center: [1, 2, 3], keys: [[0.5, 0, 0, 0], [1.5, 0, 1, 0.2]]}\n"));
+  const auto* syn = dynamic_cast<const SyntheticSource*>(src.get());
+  ASSERT_NE(syn, nullptr);
+  const auto at = [&](std::uint64_t k) { return syn->frameAt(k).bodies[0].pose.p; };
+  EXPECT_LT((at(0) - math::Vector3(1, 2, 3)).norm(), 1e-12);     // before the first key
+  EXPECT_LT((at(50) - math::Vector3(1, 2, 3)).norm(), 1e-12);    // at it
+  EXPECT_LT((at(100) - math::Vector3(1, 2.5, 3.1)).norm(), 1e-12);  // half way (smoothstep(0.5) = 0.5)
+  EXPECT_NEAR(at(75).y(), 2 + 0.25 * 0.25 * (3 - 0.5), 1e-12);   // eased: smoothstep(0.25) = 0.15625
+  EXPECT_LT((at(150) - math::Vector3(1, 3, 3.2)).norm(), 1e-12);
+  EXPECT_LT((at(400) - math::Vector3(1, 3, 3.2)).norm(), 1e-12);  // held after the last
+  const auto expectError = [](const std::string& yaml, const std::string& what) {
+    try {
+      makeSource(configOf(yaml));
+      ADD_FAILURE() << "no error for\n" << yaml;
+    } catch (const core::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  expectError("source: synthetic\nsynthetic:\n  bodies:\n    - name: a\n      keys: [[0, 0, 0, 0], [0, 1, 0, 0]]\n",
+              "test.yaml:5: field 'synthetic.bodies[0].keys[1][0]': key times must increase");
+  expectError("source: synthetic\nsynthetic:\n  bodies:\n    - name: a\n      keys: [[0, 0, 0]]\n",
+              "test.yaml:5: field 'synthetic.bodies[0].keys[0]': a key is [time s, dx, dy, dz]");
+}
+
 TEST(MocapConfig, BuildsSourcesAndNamesFileLineAndField) {
   auto bvh = makeSource(configOf(
       "source: bvh\nbvh:\n  file: data/bvh/cmu_max_131_03.bvh\n  map: configs/mappings/cmu.yaml\n  bodies: [pelvis, head]\n"));
