@@ -4,6 +4,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <memory>
@@ -12,6 +13,7 @@
 #include "mannequin/math/so3.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/simservice/messages.hpp"
+#include "mannequin/simservice/offline.hpp"
 #include "mannequin/simservice/sim_service.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/transport/convert.hpp"
@@ -393,6 +395,76 @@ TEST(SimConfig, MocapSourcesAreValidated) {
   EXPECT_TRUE(c.mocap_sources[1].connect.empty());
   EXPECT_EQ(c.mannequins[0].mocap_source, "mocap_b");
   EXPECT_EQ(simservice::buildMannequins(c)[0].mocap_source, "mocap_b");
+}
+
+// Offline (mannequin-simulate), each `mocap_sources` entry with its own `mocap` plays its own capture: two
+// scripted actors 2 m apart drive two mannequins, each ending where its own capture stands (with one capture
+// for every source both would stand in one place); a missing capture names the sim config's line, a bad one
+// its own line, and --mocap (the main capture) is refused when no mannequin plays it.
+TEST(SimOffline, EachMocapSourcePlaysItsOwnCapture) {
+  namespace fs = std::filesystem;
+  const fs::path dir = fs::temp_directory_path() / ("mannequin_offline_sources_" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const auto actor = [&](const std::string& file, double x, double yb) {
+    std::ofstream(dir / file) << "name: mocap\nsource: synthetic\nsynthetic:\n  rate_hz: 120\n  duration: 0.5\n  bodies:\n"
+                              << "    - {name: pelvis, waypoints: [{t: 0, xyz: [" << x << ", 0, 0.932]}, {t: 0.4, xyz: [" << x << ", " << yb
+                              << ", 0.932]}]}\n"
+                              << "    - {name: head, center: [" << x << ", 0, 1.469]}\n"
+                              << "    - {name: foot_l, center: [" << x << ", 0.094, 0.068]}\n"
+                              << "    - {name: foot_r, center: [" << x << ", -0.094, 0.068]}\n";
+  };
+  actor("a.yaml", -1.0, 0.0);
+  actor("b.yaml", 1.0, 0.05);
+  const auto write = [&](const std::string& source_a) {
+    std::ofstream(dir / "sim.yaml")
+        << "name: sim\nstep: 0.001\nmocap_sources:\n  - {name: sa, mocap: " << source_a << "}\n"
+        << "  - {name: sb, mocap: " << (dir / "b.yaml").string() << "}\n"
+        << "mannequins:\n"
+        << "  - {name: a, mocap_source: sa, config: configs/mannequins/male_50th.yaml,\n"
+        << "     control_frames: {pelvis: pelvis, head: head, foot_l: foot_l, foot_r: foot_r}}\n"
+        << "  - {name: b, mocap_source: sb, config: configs/mannequins/male_50th.yaml,\n"
+        << "     control_frames: {pelvis: pelvis, head: head, foot_l: foot_l, foot_r: foot_r}}\n";
+  };
+  write((dir / "a.yaml").string());
+  simservice::OfflineOptions o;
+  o.config = (dir / "sim.yaml").string();
+  {
+    simservice::OfflineRun run(o);
+    EXPECT_EQ(run.config().mocap_sources[1].mocap, (dir / "b.yaml").string());
+    EXPECT_NEAR(run.captureLength(), 0.5, 1e-12);  // the clock: the first mannequin's capture
+    const simservice::OfflineSummary s = run.run();
+    const sim::World& w = run.world();
+    const auto pelvis = [&](int m) { return w.data(m).oMf[static_cast<std::size_t>(w.model(m).frameIndex("pelvis"))].p; };
+    std::printf("own captures: %lld frames, %.3f s; pelvis a (%.4f, %.4f), b (%.4f, %.4f)\n", s.frames, s.sim_time_s,
+                pelvis(0).x(), pelvis(0).y(), pelvis(1).x(), pelvis(1).y());
+    EXPECT_EQ(s.nan_steps, 0);
+    EXPECT_NEAR(s.sim_time_s, 0.5, 0.01);
+    EXPECT_GE(s.frames, 2 * 60);  // both captures' frames fed (120 Hz, 0.5 s each)
+    EXPECT_NEAR(pelvis(0).x(), -1.0, 0.02);
+    EXPECT_NEAR(pelvis(1).x(), 1.0, 0.02);
+    EXPECT_NEAR(pelvis(0).y(), 0.0, 0.01);
+    EXPECT_NEAR(pelvis(1).y(), 0.05, 0.01);  // b's own waypoints moved it 5 cm
+  }
+  const auto expectError = [&](const std::string& what, const simservice::OfflineOptions& opts) {
+    try {
+      simservice::OfflineRun run(opts);
+      ADD_FAILURE() << "no error, expected " << what;
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << "got: " << e.what();
+    }
+  };
+  write((dir / "missing.yaml").string());
+  expectError((dir / "sim.yaml").string() + ":4: field 'mocap_sources[0].mocap'", o);
+  std::ofstream(dir / "bad.yaml") << "name: mocap\nsource: synthetic\nsynthetic:\n  rate_hz: 120\n  bodies:\n    - {name: pelvis}\n";
+  write((dir / "bad.yaml").string());
+  expectError((dir / "bad.yaml").string() + ":4: field 'synthetic.duration'", o);  // a scripted capture without an end
+  std::ofstream(dir / "bad.yaml") << "name: mocap\nsource: synthetic\nsynthetic:\n  duration: 1\n  bodies:\n    - {name: pelvis, waypoints: 3}\n";
+  expectError((dir / "bad.yaml").string() + ":6", o);
+  write((dir / "a.yaml").string());
+  simservice::OfflineOptions with_mocap = o;
+  with_mocap.mocap = "data/bvh/cmu_max_131_03.bvh";
+  expectError("no mannequin plays the main capture", with_mocap);
+  fs::remove_all(dir);
 }
 
 TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {

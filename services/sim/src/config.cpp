@@ -207,13 +207,15 @@ SimServiceConfig parseSimConfig(const ConfigNode& root) {
   if (auto sc = root.find("scenario")) parseScenarioSettings(*sc, c.scenario);
   if (auto ms = root.find("mocap_sources"))
     for (const ConfigNode& s : ms->items()) {
-      s.allowOnly({"name", "connect"});
+      s.allowOnly({"name", "connect", "mocap"});
       MocapSourceEntry e;
+      e.where = s.where();
       e.name = s["name"].str();
       if (e.name.empty()) s["name"].fail("must not be empty (the mocap service's name, Header.source of its frames)");
       for (const MocapSourceEntry& o : c.mocap_sources)
         if (o.name == e.name) s["name"].fail("mocap source '" + e.name + "' listed twice");
       if (auto cn = s.find("connect")) e.connect = cn->strings();
+      if (auto mo = s.find("mocap")) e.mocap = resolvePath(*mo);
       c.mocap_sources.push_back(e);
     }
   for (const ConfigNode& m : root["mannequins"].items()) {

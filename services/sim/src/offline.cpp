@@ -105,6 +105,54 @@ class Progress {
   std::string label_;
 };
 
+/// A capture opened for an offline run: the source (unpaced, once), its length (0: unknown) and file.
+struct Capture {
+  std::unique_ptr<mocap::Source> source;
+  double length_s = 0;
+  std::string file;
+};
+
+/// Opens the mocap config at `mocap_path` (a BVH capture, or a scripted one: source synthetic with a duration);
+/// `bvh_file` (when not empty) replaces its BVH file. \throws core::ConfigError naming FILE:LINE.
+Capture openCapture(const std::string& mocap_path, const std::string& bvh_file) {
+  YAML::Node raw;
+  try {
+    raw = YAML::LoadFile(mocap_path);
+  } catch (const YAML::Exception& e) {
+    throw core::ConfigError(fmt::format("{}:{}: {}", mocap_path, e.mark.line + 1, e.msg));
+  }
+  if (!raw.IsMap()) throw core::ConfigError(mocap_path + ":1: a mocap config (a map with `source: bvh` and a `bvh` section)");
+  Capture cap;
+  const bool scripted = raw["source"] && raw["source"].as<std::string>("") == "synthetic" && raw["synthetic"] && bvh_file.empty();
+  if (scripted) {
+    // a scripted capture (source: synthetic, e.g. configs/sim/mocap_lean.yaml): its `duration` once, unpaced
+    const double duration = raw["synthetic"]["duration"].as<double>(0.0);
+    if (!(duration > 0))
+      throw core::ConfigError(fmt::format("{}:{}: field 'synthetic.duration': mannequin-simulate needs a scripted capture of "
+                                          "finite length (duration > 0 s)", mocap_path, raw["synthetic"].Mark().line + 1));
+    raw["synthetic"]["paced"] = false;
+    cap.file = mocap_path;
+    cap.source = mocap::makeSource(core::ConfigNode(raw, mocap_path));
+    cap.length_s = duration;
+    return cap;
+  }
+  if (!raw["source"] || raw["source"].as<std::string>("") != "bvh" || !raw["bvh"]) {
+    const YAML::Mark at = raw["source"] ? raw["source"].Mark() : raw.Mark();
+    throw core::ConfigError(
+        fmt::format("{}:{}: field 'source': mannequin-simulate plays BVH captures (source: bvh with a bvh section) "
+                    "and scripted ones (source: synthetic with a duration)",
+                    mocap_path, at.line + 1));
+  }
+  if (!bvh_file.empty()) raw["bvh"]["file"] = bvh_file;
+  raw["bvh"]["loop"] = false;   // the capture once
+  raw["bvh"]["paced"] = false;  // as fast as asked for
+  cap.file = raw["bvh"]["file"].as<std::string>("");
+  cap.source = mocap::makeSource(core::ConfigNode(raw, mocap_path));
+  if (const auto* b = dynamic_cast<const mocap::BvhSource*>(cap.source.get()))
+    cap.length_s = b->bvh().num_frames * b->bvh().frame_time / raw["bvh"]["rate"].as<double>(1.0);
+  return cap;
+}
+
 }  // namespace
 
 OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
@@ -126,8 +174,15 @@ OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
       spdlog::info("collision: mode service needs mannequin-collision on the network: not used here{}",
                    c.world.physics.enabled ? " (the physics queries its own collision world)" : "");
 
+    // the main capture drives the default source and every mocap source without its own `mocap`
+    bool needs_main = false;
+    for (const MannequinEntry& e : c.mannequins) {
+      bool own_capture = false;
+      for (const MocapSourceEntry& s : c.mocap_sources) own_capture = own_capture || (s.name == e.mocap_source && !s.mocap.empty());
+      needs_main = needs_main || !own_capture;
+    }
     const bool c3d = !options.mocap.empty() && endsWith(options.mocap, ".c3d");
-    if (c3d) {
+    if (c3d && needs_main) {
       // a C3D lab capture: the mocap library's `source: c3d`, its marker clusters as rigid bodies; the
       // mannequins driven by the control frames whose bodies the mapping has
       YAML::Node raw;
@@ -160,47 +215,41 @@ OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
       }
       if (cs && cs->c3d().rate > 0) capture_length_s_ = cs->c3d().frames_present / cs->c3d().rate;
       capture_file_ = options.mocap;
-    } else {
+    } else if (needs_main) {
       // the sim config's `mocap` (a mocap service config), --mocap replacing its BVH file
       const std::string mocap_path = c.mocap.empty() ? core::findData("configs/sim/mocap_demo.yaml") : c.mocap;
-      YAML::Node raw;
-      try {
-        raw = YAML::LoadFile(mocap_path);
-      } catch (const YAML::Exception& e) {
-        throw core::ConfigError(fmt::format("{}:{}: {}", mocap_path, e.mark.line + 1, e.msg));
-      }
-      if (!raw.IsMap()) throw core::ConfigError(mocap_path + ":1: a mocap config (a map with `source: bvh` and a `bvh` section)");
-      const bool scripted = raw["source"] && raw["source"].as<std::string>("") == "synthetic" && raw["synthetic"] && options.mocap.empty();
-      if (scripted) {
-        // a scripted capture (source: synthetic, e.g. configs/sim/mocap_lean.yaml): its `duration` once, unpaced
-        const double duration = raw["synthetic"]["duration"].as<double>(0.0);
-        if (!(duration > 0))
-          throw core::ConfigError(fmt::format("{}:{}: field 'synthetic.duration': mannequin-simulate needs a scripted capture of "
-                                              "finite length (duration > 0 s)", mocap_path, raw["synthetic"].Mark().line + 1));
-        raw["synthetic"]["paced"] = false;
-        capture_file_ = mocap_path;
-        source_ = mocap::makeSource(core::ConfigNode(raw, mocap_path));
-        capture_length_s_ = duration;
-      } else if (!raw["source"] || raw["source"].as<std::string>("") != "bvh" || !raw["bvh"]) {
-        const YAML::Mark at = raw["source"] ? raw["source"].Mark() : raw.Mark();
-        throw core::ConfigError(
-            fmt::format("{}:{}: field 'source': mannequin-simulate plays BVH captures (source: bvh with a bvh section) "
-                        "and scripted ones (source: synthetic with a duration)",
-                        mocap_path, at.line + 1));
-      }
-      if (!scripted) {
-        if (!options.mocap.empty()) raw["bvh"]["file"] = options.mocap;
-        raw["bvh"]["loop"] = false;   // the capture once
-        raw["bvh"]["paced"] = false;  // as fast as asked for
-        capture_file_ = raw["bvh"]["file"].as<std::string>("");
-        source_ = mocap::makeSource(core::ConfigNode(raw, mocap_path));
-        if (const auto* b = dynamic_cast<const mocap::BvhSource*>(source_.get()))
-          capture_length_s_ = b->bvh().num_frames * b->bvh().frame_time / raw["bvh"]["rate"].as<double>(1.0);
-      }
+      Capture cap = openCapture(mocap_path, options.mocap);
+      source_ = std::move(cap.source);
+      capture_length_s_ = cap.length_s;
+      capture_file_ = cap.file;
+    } else if (!options.mocap.empty()) {
+      throw OfflineInputError(fmt::format("--mocap {}: no mannequin plays the main capture (every mocap source in {} has its own `mocap`)",
+                                          options.mocap, options.config));
+    }
+    // the mocap sources with their own capture (`mocap_sources[i].mocap`)
+    std::vector<Feed> own;
+    for (const MocapSourceEntry& e : c.mocap_sources) {
+      if (e.mocap.empty()) continue;
+      Capture cap = openCapture(e.mocap, "");
+      own.push_back({std::move(cap.source), {e.name}, cap.file, cap.length_s, std::nullopt});
     }
     if (!options.scenario.empty()) replaceScenario(c, options.scenario);
     world_ = std::make_unique<sim::World>(buildMannequins(c), c.world);
     setupScenario(*world_, c);
+    const std::vector<std::string> names = world_->mocapSources();  // "" first
+    if (source_) {
+      Feed main{std::move(source_), {}, capture_file_, capture_length_s_, std::nullopt};
+      for (const std::string& n : names) {
+        bool own_capture = false;
+        for (const Feed& f : own) own_capture = own_capture || f.names.front() == n;
+        if (!own_capture) main.names.push_back(n);
+      }
+      feeds_.push_back(std::move(main));
+    }
+    for (Feed& f : own)  // those a mannequin names
+      if (std::find(names.begin(), names.end(), f.names.front()) != names.end()) feeds_.push_back(std::move(f));
+    capture_length_s_ = feeds_.front().length_s;  // the clock's
+    capture_file_ = feeds_.front().file;
   } catch (const OfflineInputError&) {
     throw;
   } catch (const std::exception& e) {  // a bad file: its FILE:LINE message
@@ -310,23 +359,33 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
                     options_.progress_label);
   const auto t0 = std::chrono::steady_clock::now();
   const auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
-  const std::vector<std::string> sources = world.mocapSources();  // "" first
   bool done = false;
   try {
-    while (!done && !source_->finished()) {
-      const std::optional<mocap::Frame> f = source_->next(std::chrono::microseconds(0));
-      if (!f) continue;
+    // the captures merged in time order (ties: the clock's frame last), the World stepped up to each of the clock's
+    Feed& clock = feeds_.front();
+    const std::string& clock_name = clock.names.front();
+    while (!done) {
+      for (Feed& fd : feeds_)
+        while (!fd.pending && !fd.source->finished()) fd.pending = fd.source->next(std::chrono::microseconds(0));
+      if (!clock.pending) break;  // the clock's capture is over
+      Feed* next = &clock;
+      for (Feed& fd : feeds_)
+        if (&fd != &clock && fd.pending &&
+            (fd.pending->stamp_ns < next->pending->stamp_ns || (next == &clock && fd.pending->stamp_ns == next->pending->stamp_ns)))
+          next = &fd;
+      const mocap::Frame f = std::move(*next->pending);
+      next->pending.reset();
       ++s.frames;
-      for (const mocap::Body& b : f->bodies)  // a NaN sample: the file and its frame, not a NaN world
+      for (const mocap::Body& b : f.bodies)  // a NaN sample: the file and its frame, not a NaN world
         if (b.tracked && !(b.pose.p.allFinite() && b.pose.R.allFinite()))
-          throw OfflineInputError(fmt::format("{}: frame {}: body '{}': non-finite sample", capture_file_,
-                                              f->frame_number, b.name));
-      // the one capture drives every mocap source the mannequins name (sim config `mocap_sources`)
-      for (const std::string& src : sources) {
-        world.addMocap(*f, src);
-        if (!world.anchored(src)) world.anchor(f->stamp_ns, src);
+          throw OfflineInputError(fmt::format("{}: frame {}: body '{}': non-finite sample", next->file, f.frame_number, b.name));
+      // a capture drives the mocap sources it was given: the main one every source without its own `mocap`
+      for (const std::string& src : next->names) {
+        world.addMocap(f, src);
+        if (!world.anchored(src)) world.anchor(f.stamp_ns, src);
       }
-      while (world.captureTimeNs(sources.front()) + step_ns <= f->stamp_ns) {
+      if (next != &clock) continue;
+      while (world.captureTimeNs(clock_name) + step_ns <= f.stamp_ns) {
         if (world.time() + 0.5 * config.world.step >= total) {
           done = true;
           break;

@@ -40,6 +40,10 @@ struct MannequinEntry {
 struct MocapSourceEntry {
   std::string name;                  ///< the mocap service's name (Header.source of its frames)
   std::vector<std::string> connect;  ///< its publisher endpoints (added to the subscriber's; may be empty)
+  /// Key `mocap`: the mocap config mannequin-simulate plays offline for this source alone (resolved like the
+  /// top-level `mocap`); "" when absent: the top-level capture drives it. The service ignores it.
+  std::string mocap;
+  std::string where;  ///< FILE:LINE of the entry
 };
 
 /// An operator trigger at a sim time (key `scenario.triggers`): what a scripted run (mannequin-simulate,

@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -136,9 +137,18 @@ class OfflineRun {
   const std::string& captureFile() const { return capture_file_; }
 
  private:
+  /// A capture and the mocap sources it drives (World source names); feeds_[0] is the clock the World steps to.
+  struct Feed {
+    std::unique_ptr<mocap::Source> source;
+    std::vector<std::string> names;
+    std::string file;
+    double length_s = 0;
+    std::optional<mocap::Frame> pending;  ///< read, not yet fed
+  };
   OfflineOptions options_;
   SimServiceConfig config_;
-  std::unique_ptr<mocap::Source> source_;
+  std::unique_ptr<mocap::Source> source_;  ///< the main capture (nullptr when every mocap source has its own)
+  std::vector<Feed> feeds_;
   std::unique_ptr<sim::World> world_;
   std::vector<ergonomics::Evaluator> evaluators_;
   double capture_length_s_ = 0;
