@@ -302,6 +302,10 @@ TEST(C3dMalformed, HugeCountsAreCheckedBeforeAllocating) {
   p.padTo(4 * 512);
   expectError(p.s, 512 + 4 + 2 + 3 + 2 + 2, "parameter BIG: dimensions give more data than the parameter section holds");
 
+  // a scale so large that int16 samples times it overflow a float (found by fuzz-c3d: 4.4e35): refused
+  WriteSpec big = w;
+  big.scale = 4.4e35;
+  expectError(c3dtest::writeC3d(big), 12, "is too large");
   // a last frame before the first
   std::string d = c3dtest::writeC3d(w);
   d[6] = 5;  // first frame 5, last frame 1

@@ -313,6 +313,11 @@ C3d parseC3d(std::string_view bytes, const std::string& file) {
     if (data_start < 0) r.fail(s->second, "POINT:DATA_START is not a whole block number (" + std::to_string(s->first) + ")");
   }
   if (!std::isfinite(scale) || scale == 0.0) r.fail(12, "bad point scale " + std::to_string(scale) + " (header or POINT:SCALE)");
+  // an int16 sample (|v| <= 32768) or a residual (<= 255) times the scale must stay a finite float: real files
+  // scale by 0.001–10; 1e30 leaves 3.3e34 of FLT_MAX's 3.4e38
+  if (std::abs(scale) > 1e30) {
+    r.fail(12, "point scale " + std::to_string(scale) + " is too large (header or POINT:SCALE): samples times it overflow a float (|scale| <= 1e30)");
+  }
   if (!std::isfinite(rate) || rate < 0.0) r.fail(20, "bad frame rate " + std::to_string(rate) + " (header or POINT:RATE)");
   c.scale = scale;
   c.rate = rate;
