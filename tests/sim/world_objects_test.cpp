@@ -796,12 +796,15 @@ TEST(WorldScenario, AttachGuideHoldsATrayLevelAndDetachGuideLetsItFall) {
   World w(std::move(setups), physicsConfig(scene));
   const int tray = w.findObject("tray");
   ASSERT_GE(tray, 0);
-  const std::string head = "scenario: tray\nmannequins:\n  - name: operator\n    frames: [hand_r]\nobjects: [tray, door]\n";
+  const std::string head = "scenario: tray\nmannequins:\n  - name: operator\n    frames: [hand_r]\n";
+  const std::string objects = "objects: [{name: tray, values: [z, x]}, {name: door, values: [angle]}]\n";
   w.setScenario(scenario::parseScenario(
-      head + "triggers: [drop]\ninitial: level\nstates:\n  - name: level\n    modes: {hand_r: free}\n    entry:\n"
+      head + objects + "triggers: [drop]\ninitial: level\nstates:\n  - name: level\n    modes: {hand_r: free}\n    entry:\n"
              "      - attach_guide: {object: tray, mechanism: {type: plane, origin: {xyz: [0.8, 0.4, 1.0]}}}\n"
              "    transitions:\n      - {to: fall, when: {trigger: drop}}\n"
-             "  - name: fall\n    modes: {hand_r: free}\n    entry:\n      - detach_guide: {object: tray}\n",
+             "  - name: fall\n    modes: {hand_r: free}\n    entry:\n      - detach_guide: {object: tray}\n"
+             "    transitions:\n      - {to: down, when: {object: {name: tray, value: z, below: 0.9}}}\n"
+             "  - name: down\n    modes: {hand_r: free}\n",
       "tray.yaml"));
   const math::SE3 base = placed(0, 0, 0);
   w.addMocap(actorFrame(0, base));
@@ -829,14 +832,19 @@ TEST(WorldScenario, AttachGuideHoldsATrayLevelAndDetachGuideLetsItFall) {
   EXPECT_NEAR(g->force(tray).z(), 9.81, 0.01);      // the guide carries its weight
   EXPECT_EQ(w.scenarioUnappliedActions(), 0);
   w.trigger("drop");
-  ASSERT_TRUE(run(w, 1.0, 0.5, feed));
+  // the object value z (its frame origin's height) ends the fall: still above 0.9 m after 0.1 s at g τ
+  // (0.49 m/s), below it after 0.5 s
+  ASSERT_TRUE(run(w, 1.0, 0.1, feed));
   EXPECT_EQ(w.scenarioEngine()->stateName(), "fall");
   EXPECT_FALSE(g->guided(tray));
-  EXPECT_LT(w.object(tray).pose().p.z(), 1.0 - 0.1);  // falling at g τ (0.49 m/s)
+  EXPECT_GT(w.object(tray).pose().p.z(), 0.9);
+  ASSERT_TRUE(run(w, 1.1, 0.4, feed));
+  EXPECT_EQ(w.scenarioEngine()->stateName(), "down");
+  EXPECT_LT(w.object(tray).pose().p.z(), 1.0 - 0.1);
   // guides the World cannot apply are refused at setScenario, naming the action's line
   const auto refused = [&](const std::string& action, const std::string& what) {
     try {
-      w.setScenario(scenario::parseScenario(head + "initial: a\nstates:\n  - name: a\n    modes: {hand_r: free}\n    entry:\n" + action,
+      w.setScenario(scenario::parseScenario(head + "objects: [tray, door]\ninitial: a\nstates:\n  - name: a\n    modes: {hand_r: free}\n    entry:\n" + action,
                                             "bad.yaml"));
       ADD_FAILURE() << "accepted: " << action;
     } catch (const std::invalid_argument& e) {
@@ -847,4 +855,14 @@ TEST(WorldScenario, AttachGuideHoldsATrayLevelAndDetachGuideLetsItFall) {
   refused("      - attach_guide: {object: tray, mechanism: {type: curve, points: [[0, 0, 1], [1, 0, 1]]}}\n", "curve");
   refused("      - attach_guide: {object: door, mechanism: {type: prismatic}}\n", "hinged");
   refused("      - attach_guide: {object: tray, mechanism: {type: plane, normal_force: 5}}\n", "force");
+  // values the World does not report: an angle of a free object, an unknown name
+  for (const char* bad : {"objects: [{name: tray, values: [angle]}]\n", "objects: [{name: tray, values: [w]}]\n"}) {
+    try {
+      w.setScenario(scenario::parseScenario(head + bad + "initial: a\nstates:\n  - name: a\n    modes: {hand_r: free}\n", "bad.yaml"));
+      ADD_FAILURE() << "accepted: " << bad;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find("value '"), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("'x', 'y', 'z'"), std::string::npos) << e.what();
+    }
+  }
 }

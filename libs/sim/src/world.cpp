@@ -427,6 +427,7 @@ struct World::ScenarioRun {
   };
   std::vector<Frame> frames;       // per scenario frame
   std::vector<int> objects;        // per scenario object: the World's object index
+  std::vector<std::vector<int>> value_kind;  // per scenario object, per declared value: 0 angle, 1..3 x, y, z
   std::vector<int> grasp_handle;   // per scenario frame: its grasp (−1: none)
   std::vector<char> guided;        // per scenario object: 1 while a guide it attached holds it
   std::vector<const control::MechanismConfig*> mechanism;  // per scenario frame: the one its controller runs (into the engine's scenario)
@@ -466,11 +467,17 @@ void World::setScenario(scenario::Scenario sc) {
   for (const scenario::ObjectDecl& o : sc.objects) {
     const int k = physics_ ? findObject(o.name) : -1;
     if (k < 0) throw std::invalid_argument(where + ": no object '" + o.name + "' in the World (movable scene bodies, physics on)");
-    for (const std::string& v : o.values)
-      if (v != "angle" || !object(k).hinged())
+    std::vector<int> kinds;
+    for (const std::string& v : o.values) {
+      if (v == "angle" && object(k).hinged()) kinds.push_back(0);
+      else if (v == "x" || v == "y" || v == "z") kinds.push_back(1 + (v[0] - 'x'));
+      else
         throw std::invalid_argument(where + ": object '" + o.name + "' value '" + v +
-                                    "': the World reports only 'angle', of hinged objects");
+                                    "': the World reports 'angle' (of hinged objects) and 'x', 'y', 'z' (the object's "
+                                    "frame origin in the world, m)");
+    }
     run->objects.push_back(k);
+    run->value_kind.push_back(std::move(kinds));
   }
   // guides on objects: what the World's GuideRows cannot take is refused now, not at the action
   for (const scenario::State& st : sc.states)
@@ -549,7 +556,10 @@ void World::stepScenario() {
   for (std::size_t k = 0; k < S.objects.size(); ++k) {
     const RigidObject& o = object(S.objects[k]);
     obs.objects[k].pose = o.pose();
-    for (double& v : obs.objects[k].values) v = o.angle();
+    for (std::size_t i = 0; i < obs.objects[k].values.size(); ++i) {
+      const int kind = S.value_kind[k][i];
+      obs.objects[k].values[i] = kind == 0 ? o.angle() : o.pose().p(kind - 1);
+    }
   }
   obs.triggers.swap(S.pending);
   S.pending.clear();
