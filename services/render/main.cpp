@@ -1,6 +1,7 @@
 // mannequin-render: one render node, one view (docs/render.md). A thin main over mannequin::render.
 //   --headless: an off-screen EGL context, PNG frames into --out (deterministic: the same input gives the
-//               same files); --from F.mcap renders the sim.world messages of a recording frame by frame.
+//               same files); --from F.mcap renders the sim.world messages of a recording frame by frame;
+//               --sheet COLS also tiles the frames into one contact sheet (DIR/sheet.png).
 //   otherwise:  a GLFW window (needs a display); --from plays the recording at its own pace, looping.
 //   --connect:  the live sim.world of publishers (newest state; headless: a frame per new state).
 //               A wall view with `head_body` takes its eye from that rigid body of mocap.frame (same endpoints).
@@ -58,7 +59,10 @@ struct Options {
   bool overlay = false;  // --overlay: the text line (frame, render fps, sim lateness)
   int every = 1;
   long long frames = 0;  // 0: all
+  int sheet = 0;         // --sheet COLS: the frames also tiled into DIR/sheet.png, COLS per row (0: no sheet)
 };
+
+constexpr long long kMaxSheetFrames = 64;  // a contact sheet holds every frame in memory
 
 /// The node on the network: the ZeroMQ context of its sockets and, with --publish (a node of a deployment),
 /// its publisher and heartbeats (state RUNNING while it draws, frames counted in the loop rate).
@@ -299,6 +303,10 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     spdlog::error("--headless needs --out DIR (where the PNG frames go)");
     return core::kExitUsage;
   }
+  if (o.sheet > 0 && (o.frames < 1 || o.frames > kMaxSheetFrames)) {
+    spdlog::error("--sheet needs --frames K with 1 <= K <= {} (the sheet's frames are kept in memory); got --frames {}", kMaxSheetFrames, o.frames);
+    return core::kExitUsage;
+  }
   fs::create_directories(o.out);
   render::HeadlessContext ctx(w, h);
   render::Renderer renderer;
@@ -309,6 +317,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
   const auto cameraOf = [&](const v1::WorldState* ws) { return followedView(view, view.orbit, ws, view.follow).eyes(w, h); };
   std::set<std::string> tried;
   long long written = 0;
+  std::vector<render::Image> sheet;
   OverlayText overlay;
   const auto emit = [&](const render::RenderScene& scene, const std::vector<render::EyeView>& eyes, std::size_t index,
                         const v1::WorldState* ws, bool live) {
@@ -316,7 +325,9 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     if (layers.overlay && ws != nullptr) OverlayText::draw(renderer, overlay.line(*ws, live), eyes, h);
     char name[64];
     std::snprintf(name, sizeof name, "frame_%06zu.png", index);
-    render::writePng((fs::path(o.out) / name).string(), ctx.read());
+    const render::Image image = ctx.read();
+    render::writePng((fs::path(o.out) / name).string(), image);
+    if (o.sheet > 0) sheet.push_back(image);
     ++written;
     link.frameDrawn();
     link.service(written);
@@ -398,6 +409,12 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     }
   }
   std::printf("wrote %lld frames (%dx%d) to %s\n", written, w, h, o.out.c_str());
+  if (!sheet.empty()) {
+    const render::Image tiled = render::tile(sheet, o.sheet, 4, {255, 255, 255});
+    const std::string path = (fs::path(o.out) / "sheet.png").string();
+    render::writePng(path, tiled);
+    std::printf("wrote the contact sheet of %zu frames (%dx%d) to %s\n", sheet.size(), tiled.width, tiled.height, path.c_str());
+  }
   return core::kExitOk;
 }
 
@@ -631,6 +648,9 @@ int main(int argc, char** argv) {
   app.add_option("--out", o.out, "directory of the PNG frames (frame_NNNNNN.png, N = message index)");
   app.add_option("--every", o.every, "render every Nth message")->check(CLI::PositiveNumber)->capture_default_str();
   app.add_option("--frames", o.frames, "write at most K frames (0: all); a window closes after K frames")->check(CLI::NonNegativeNumber);
+  app.add_option("--sheet", o.sheet,
+                 "headless: also tile the frames into DIR/sheet.png, COLS per row, 4 px white gaps (needs --frames K, K <= 64)")
+      ->check(CLI::PositiveNumber);
   app.add_option("--name", o.name, "node name (heartbeats; mannequin-launch passes the service name)")->capture_default_str();
   app.add_option("--publish", o.publish,
                  "publish heartbeats on this endpoint (repeatable; mannequin-launch passes the service's endpoint)");

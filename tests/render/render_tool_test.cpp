@@ -20,6 +20,7 @@
 #include "fixtures.hpp"
 #include "mannequin/proto/schema.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
+#include "mannequin/render/renderer.hpp"
 #include "mannequin/transport/publisher.hpp"
 #include "mannequin/transport/topics.hpp"
 
@@ -114,6 +115,25 @@ TEST_F(RenderTool, RendersARecordingHeadlessFrameByFrameDeterministically) {
   for (const auto& n : names) EXPECT_EQ(slurp(a / n), slurp(b / n)) << n << " differs between two runs";
   // the mannequin moves: consecutive frames differ
   EXPECT_NE(slurp(a / names[0]), slurp(a / names[1]));
+  // --sheet: the frames tiled, 2 per row, 4 px gaps: frame k's pixels at (4 + (k % 2)·164, 4 + (k / 2)·124)
+  const fs::path sh = temp("sheet");
+  const ToolResult rs = run(common + " --every 2 --frames 3 --sheet 2 --out " + sh.string());
+  ASSERT_EQ(rs.exit_code, 0) << rs.err;
+  const render::Image sheet = render::readPng((sh / "sheet.png").string());
+  EXPECT_EQ(sheet.width, 2 * 160 + 3 * 4);
+  EXPECT_EQ(sheet.height, 2 * 120 + 3 * 4);
+  for (int k = 0; k < 3; ++k) {
+    const render::Image frame = render::readPng((a / names[static_cast<std::size_t>(k)]).string());
+    const int x0 = 4 + (k % 2) * 164, y0 = 4 + (k / 2) * 124;
+    long differ = 0;
+    for (int y = 0; y < 120; ++y)
+      for (int x = 0; x < 160; ++x) differ += sheet.at(x0 + x, y0 + y) != frame.at(x, y);
+    EXPECT_EQ(differ, 0) << "tile " << k << " is not frame " << names[static_cast<std::size_t>(k)];
+  }
+  // a sheet without a bounded frame count is refused before anything is drawn
+  const ToolResult unbounded = run(common + " --sheet 2 --out " + temp("sheet2").string());
+  EXPECT_EQ(unbounded.exit_code, 2) << unbounded.err;
+  EXPECT_NE(unbounded.err.find("--sheet needs --frames"), std::string::npos) << unbounded.err;
   // --frames caps the count
   const ToolResult rc = run(common + " --frames 2 --out " + c.string());
   ASSERT_EQ(rc.exit_code, 0) << rc.err;

@@ -44,6 +44,14 @@ struct Image {
 
 /// Writes an 8-bit RGB PNG (libpng). \throws RenderError naming the file.
 void writePng(const std::string& path, const Image& image);
+/// Reads a PNG (any bit depth and colour type libpng converts: palette, grey, alpha dropped, 16-bit
+/// stripped) as 8-bit RGB. \throws RenderError naming the file (missing, not a PNG, truncated).
+Image readPng(const std::string& path);
+
+/// A contact sheet: `images` (all of one size) left to right, top to bottom, `columns` per row, with `gap`
+/// pixels of `background` between them and around them. A last row that is not full stays background.
+/// \throws RenderError for no images, images of different sizes, columns < 1 or gap < 0.
+Image tile(const std::vector<Image>& images, int columns, int gap, const std::array<std::uint8_t, 3>& background);
 
 /// Draws RenderScenes with a camera into the current GL context. Build it with the context current;
 /// destroy it with the same context current.
