@@ -260,8 +260,9 @@ std::string reportHtml(const std::vector<Run>& runs, const std::string& mocap, c
       "img{border:1px solid #ccc;max-width:100%;height:auto}</style></head><body>\n";
   h += "<h1>mannequin-batch report</h1>\n<p>Capture <code>" + html(mocap) + "</code>; " + std::to_string(runs.size()) +
        " mannequin" + (runs.size() > 1 ? "s" : "") +
-       ". Scores: RULA grand score and REBA score of the worse side, per world sample (libs/ergonomics, no load, "
-       "not static, not repeated). Balance distance: signed, &gt; 0 inside the support.</p>\n";
+       ". Scores: RULA grand score and REBA score of the worse side, per world sample (libs/ergonomics; the load in "
+       "each hand from the World's grasp and contact forces on it, not static, not repeated). Hand force: the magnitude "
+       "of the force on the hand segment. Balance distance: signed, &gt; 0 inside the support.</p>\n";
   // the key numbers, mannequins side by side
   h += "<h2>Summary</h2>\n<table id=\"summary\"><tr><th></th>";
   for (const Run& r : runs) h += "<th class=\"mannequin\">" + html(r.label) + "</th>";
@@ -330,6 +331,29 @@ std::string reportHtml(const std::vector<Run>& runs, const std::string& mocap, c
     }
     h += "</table>\n";
   }
+  if (shots.count > 0) {  // the pictures first: what the numbers below are about
+    h += "<h2>Worst postures</h2>\n";
+    if (!shots.rendered) {
+      h += "<p class=\"no-snapshots\">The snapshots of the worst postures were not rendered: no headless OpenGL context "
+           "could be made here (" + html(shots.error) + "). The postures are in the run's MCAP recording "
+           "(<code>mannequin-render --from run.mcap --headless</code> draws them where OpenGL is available).</p>\n";
+    } else {
+      h += fmt::format("<p>The {} worst samples of each run by RULA (then REBA), at least {:.1f} s apart, drawn from the "
+                       "recorded sim.world state with the view <code>{}</code> (also in <code>snapshots/</code>; OpenGL: {}).</p>\n",
+                       shots.count, kSnapshotGapS, html(shots.view), html(shots.renderer));
+      h += "<div class=\"cols\">\n";
+      for (const Run& r : runs) {
+        h += "<div class=\"col\"><h3>" + html(r.label) + "</h3>\n";
+        for (const batch::Snapshot& p : r.snapshots)
+          h += fmt::format("<figure class=\"snapshot\"><img src=\"data:image/png;base64,{}\" width=\"{}\" height=\"{}\" "
+                           "alt=\"{} at {:.3f} s\"><figcaption>t = {:.3f} s: RULA {}, REBA {} ({})</figcaption></figure>\n",
+                           batch::base64(p.png), shots.width, shots.height, html(r.label), p.sample.time_s, p.sample.time_s,
+                           p.sample.rula, p.sample.reba, html(p.file));
+        h += "</div>\n";
+      }
+      h += "</div>\n";
+    }
+  }
   h += "<h2>Time series</h2>\n<div class=\"cols\">\n";
   for (const Run& r : runs) {
     h += "<div class=\"col\"><h3>" + html(r.label) + "</h3>\n";
@@ -355,29 +379,6 @@ std::string reportHtml(const std::vector<Run>& runs, const std::string& mocap, c
     h += "</table></div>\n";
   }
   h += "</div>\n";
-  if (shots.count > 0) {
-    h += "<h2>Worst postures</h2>\n";
-    if (!shots.rendered) {
-      h += "<p class=\"no-snapshots\">The snapshots of the worst postures were not rendered: no headless OpenGL context "
-           "could be made here (" + html(shots.error) + "). The postures are in the run's MCAP recording "
-           "(<code>mannequin-render --from run.mcap --headless</code> draws them where OpenGL is available).</p>\n";
-    } else {
-      h += fmt::format("<p>The {} worst samples of each run by RULA (then REBA), at least {:.1f} s apart, drawn from the "
-                       "recorded sim.world state with the view <code>{}</code> (also in <code>snapshots/</code>; OpenGL: {}).</p>\n",
-                       shots.count, kSnapshotGapS, html(shots.view), html(shots.renderer));
-      h += "<div class=\"cols\">\n";
-      for (const Run& r : runs) {
-        h += "<div class=\"col\"><h3>" + html(r.label) + "</h3>\n";
-        for (const batch::Snapshot& p : r.snapshots)
-          h += fmt::format("<figure class=\"snapshot\"><img src=\"data:image/png;base64,{}\" width=\"{}\" height=\"{}\" "
-                           "alt=\"{} at {:.3f} s\"><figcaption>t = {:.3f} s: RULA {}, REBA {} ({})</figcaption></figure>\n",
-                           batch::base64(p.png), shots.width, shots.height, html(r.label), p.sample.time_s, p.sample.time_s,
-                           p.sample.rula, p.sample.reba, html(p.file));
-        h += "</div>\n";
-      }
-      h += "</div>\n";
-    }
-  }
   return h + "</body></html>\n";
 }
 
