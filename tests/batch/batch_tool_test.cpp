@@ -294,10 +294,11 @@ TEST_F(BatchTool, WithoutAnOpenGlContextTheReportSaysSoAndTheRunSucceeds) {
   const ToolResult r = run("--snapshots 2 " + kDemo + " --mannequin configs/mannequins/male_50th.yaml --duration 1 --out " + dir.string(),
                            300, "env __EGL_VENDOR_LIBRARY_FILENAMES=/nonexistent/egl_vendor.json");
   ASSERT_EQ(r.exit_code, 0) << r.err;
-  EXPECT_NE(r.err.find("no snapshots"), std::string::npos) << r.err;
   const auto [s, out] = python(kSnapshotCheck, dir.string() + " 2 640 360");
+  if (s == 0) GTEST_SKIP() << "the EGL driver could not be taken away with __EGL_VENDOR_LIBRARY_FILENAMES (libEGL is not glvnd's?)";
   EXPECT_EQ(s, 3) << out;
   EXPECT_NE(out.find("no-gl: headless"), std::string::npos) << out;
+  EXPECT_NE(r.err.find("no snapshots"), std::string::npos) << r.err;
   const std::string report = mannequin::testutil::slurp(dir / "report.html");
   EXPECT_NE(report.find("class=\"no-snapshots\""), std::string::npos);
   EXPECT_NE(report.find("were not rendered"), std::string::npos);
