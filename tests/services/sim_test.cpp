@@ -467,6 +467,58 @@ TEST(SimOffline, EachMocapSourcePlaysItsOwnCapture) {
   fs::remove_all(dir);
 }
 
+// Offline, the loads in the hands feed RULA's force/load and REBA's load scores: the waiter (configs/sim/
+// sim_waiter.yaml) lifts a 0.8 kg tray and pushes a door. At every scored sample the assessment the run
+// hands out is the one of the posture with, per side, the load |World::handForces| / 9.80665 kg; a hand
+// force of 73.55 N is 7.5 kg (RULA force/load 1, REBA load 1); the tray and the door do load the hands
+// (some samples at 2 kg or more) and change some scores against the posture alone.
+TEST(SimOffline, HandLoadsFromGraspsAndContactsFeedRulaAndReba) {
+  EXPECT_NEAR(simservice::handLoadKg(math::Vector3(0, 0, -73.549875)), 7.5, 1e-9);
+  ergonomics::TaskInput load;
+  load.load_kg = 7.5;
+  EXPECT_EQ(ergonomics::rulaForceLoad(load), 1);
+  EXPECT_EQ(ergonomics::rebaLoad(load), 1);
+
+  simservice::OfflineOptions o;
+  o.config = "configs/sim/sim_waiter.yaml";
+  simservice::OfflineRun run(o);
+  ergonomics::Evaluator eval(run.world().model(0));
+  long long scored = 0, loaded = 0, changed = 0;
+  double max_load = 0;
+  const simservice::OfflineSummary s = run.run([&](const World& w, const std::vector<const ergonomics::Assessment*>& a) {
+    if (a.empty() || a[0] == nullptr) return;
+    ++scored;
+    const auto hands = w.handForces(0);
+    const ergonomics::PostureAngles angles = eval.measure(w.q(0));
+    bool any_load = false;
+    for (const ergonomics::Side side : {ergonomics::Side::kLeft, ergonomics::Side::kRight}) {
+      const auto k = static_cast<std::size_t>(side);
+      ergonomics::TaskInput in;
+      in.load_kg = hands[k].norm() / 9.80665;
+      max_load = std::max(max_load, in.load_kg);
+      any_load = any_load || in.load_kg >= 2.0;
+      const ergonomics::RulaSide rula = ergonomics::scoreRula(angles, side, in);
+      const ergonomics::RebaSide reba = ergonomics::scoreReba(angles, side, in);
+      EXPECT_EQ(a[0]->rula[k].force_load, rula.force_load) << w.time();
+      EXPECT_EQ(a[0]->rula[k].grand, rula.grand) << w.time();
+      EXPECT_EQ(a[0]->reba[k].load, reba.load) << w.time();
+      EXPECT_EQ(a[0]->reba[k].score, reba.score) << w.time();
+      const ergonomics::RulaSide bare = ergonomics::scoreRula(angles, side, {});
+      if (bare.grand != rula.grand) ++changed;
+    }
+    if (any_load) ++loaded;
+  });
+  const simservice::ErgonomicsSummary& e = s.ergonomics.front();
+  std::printf("waiter: %lld scored samples, %lld with a hand load >= 2 kg, %lld side scores changed by the load; "
+              "largest load %.2f kg; hand force mean / max left %.1f / %.1f N, right %.1f / %.1f N\n",
+              scored, loaded, changed, max_load, e.meanHandForce(0), e.hand_force_max_n[0], e.meanHandForce(1), e.hand_force_max_n[1]);
+  EXPECT_EQ(e.samples, scored);
+  EXPECT_EQ(e.hand_force_samples, scored);
+  EXPECT_NEAR(std::max(e.hand_load_max_kg[0], e.hand_load_max_kg[1]), max_load, 1e-9);
+  EXPECT_GT(loaded, 0);
+  EXPECT_GT(changed, 0);
+}
+
 TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {
   // two capture systems (two mocap services "mocap_a" and "mocap_b", each with its own clock: b's
   // starts at 1000 s) with the same body names; actor a stands at the origin, actor b 3 m away. The

@@ -356,6 +356,25 @@ TEST(WorldPhysics, TwoMannequinsLiftABoxByItsHandlesAndCarryIt1m) {
   // held still: the weight is carried by the four grasps, their vertical forces sum to m g
   double up = 0;
   for (const int g : handles) up += w.graspForce(g).z();
+  // what the ergonomic report reads: the grasps held (each mannequin's two hands on the box) and the force
+  // on each hand, its grasp's pull: together the box's weight, downward
+  const std::vector<GraspState> held = w.grasps();
+  ASSERT_EQ(held.size(), 4u);
+  math::Vector3 on_hands = math::Vector3::Zero();
+  for (int m = 0; m < 2; ++m) {
+    int mine = 0;
+    for (const GraspState& g : held)
+      if (g.mannequin == m) {
+        ++mine;
+        EXPECT_EQ(g.object, box);
+        EXPECT_NEAR((g.force - w.graspForce(g.handle)).norm(), 0.0, 1e-12);
+      }
+    EXPECT_EQ(mine, 2);
+    const auto f = w.handForces(m);
+    on_hands += f[0] + f[1];
+  }
+  std::printf("forces on the four hands: (%.3f, %.3f, %.3f) N\n", on_hands.x(), on_hands.y(), on_hands.z());
+  EXPECT_NEAR(on_hands.z(), -4 * 9.81, 0.02 * 4 * 9.81);
   ASSERT_TRUE(run(w, t, 2.3, [&](double tt) {
     shift = 1.0 * smooth((tt - 3.0) / 2.0);
     feed(tt);

@@ -91,6 +91,7 @@ struct World::Physics {
   std::unique_ptr<GuideRows> guides;
   struct GraspRecord {
     int object = -1, mannequin = -1;                   // −1: free slot
+    int joint = -1;                                    // joint carrying the grasping frame
   };
   std::vector<GraspRecord> grasp_records;              // per GraspRows handle
   std::unique_ptr<constraints::ConstraintSolver> solver;
@@ -693,7 +694,7 @@ int World::grasp(int m, const std::string& frame, const std::string& object_name
   const int handle = P.grasps->grasp(hand, o);
   if (handle < 0) return -1;
   if (static_cast<std::size_t>(handle) >= P.grasp_records.size()) P.grasp_records.resize(static_cast<std::size_t>(handle) + 1);
-  P.grasp_records[static_cast<std::size_t>(handle)] = {o, m};
+  P.grasp_records[static_cast<std::size_t>(handle)] = {o, m, hand.local};
   // no narrow phase between the held object and its holder (they overlap by design)
   P.cw.setIgnoresMannequin(P.object_body[static_cast<std::size_t>(o)], P.cw_mannequin[static_cast<std::size_t>(m)], true);
   return handle;
@@ -719,6 +720,48 @@ math::Vector3 World::graspForce(int handle) const {
       physics_->grasp_records[static_cast<std::size_t>(handle)].object < 0)
     return math::Vector3::Zero();
   return physics_->grasps->force(handle);
+}
+
+std::vector<GraspState> World::grasps() const {
+  std::vector<GraspState> out;
+  if (!physics_ || !physics_->grasps) return out;
+  for (std::size_t h = 0; h < physics_->grasp_records.size(); ++h) {
+    const Physics::GraspRecord& g = physics_->grasp_records[h];
+    if (g.object < 0) continue;
+    out.push_back({static_cast<int>(h), g.mannequin, g.joint, g.object, physics_->grasps->force(static_cast<int>(h))});
+  }
+  return out;
+}
+
+std::array<math::Vector3, 2> World::handForces(int m) const {
+  std::array<math::Vector3, 2> out{math::Vector3::Zero(), math::Vector3::Zero()};
+  if (!physics_ || m < 0 || m >= numMannequins()) return out;
+  const Physics& P = *physics_;
+  const skeleton::Model& model = mannequins_[static_cast<std::size_t>(m)]->model;
+  std::array<int, 2> hand{-1, -1};  // the joints carrying the hand segments
+  for (const skeleton::Segment& s : model.segments) {
+    if (s.name == "hand_l") hand[0] = s.joint;
+    if (s.name == "hand_r") hand[1] = s.joint;
+  }
+  for (int side = 0; side < 2; ++side) {
+    if (hand[static_cast<std::size_t>(side)] < 0) continue;
+    math::Vector3& f = out[static_cast<std::size_t>(side)];
+    for (std::size_t h = 0; h < P.grasp_records.size(); ++h) {
+      const Physics::GraspRecord& g = P.grasp_records[h];
+      if (g.object >= 0 && g.mannequin == m && g.joint == hand[static_cast<std::size_t>(side)])
+        f -= P.grasps->force(static_cast<int>(h));
+    }
+    const auto isHand = [&](int body) {
+      return body >= 0 && static_cast<std::size_t>(body) < P.body_mannequin.size() &&
+             P.body_mannequin[static_cast<std::size_t>(body)] == m &&
+             P.body_joint[static_cast<std::size_t>(body)] == hand[static_cast<std::size_t>(side)];
+    };
+    for (const ContactReport& c : contacts_) {  // n from a to b: a gets −λ n, b gets +λ n
+      if (isHand(c.body_a)) f -= c.normal_force * c.normal;
+      if (isHand(c.body_b)) f += c.normal_force * c.normal;
+    }
+  }
+  return out;
 }
 
 void World::attachGuide(int i, const control::MechanismSpec& spec) {

@@ -320,8 +320,25 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
       if (!world.calibrated(m)) continue;
       ErgonomicsSummary& e = s.ergonomics[i];
       try {
-        assessments[i] = evaluators_[i].evaluate(world.q(m));
-        const ergonomics::Assessment& a = assessments[i];
+        // the loads in the hands (physics on): what they hold and push, in kilograms-force, per side
+        const std::array<math::Vector3, 2> hands = world.physics() ? world.handForces(m) : std::array<math::Vector3, 2>{};
+        ergonomics::Assessment& a = assessments[i];
+        a.angles = evaluators_[i].measure(world.q(m));
+        for (const ergonomics::Side side : {ergonomics::Side::kLeft, ergonomics::Side::kRight}) {
+          const auto k = static_cast<std::size_t>(side);
+          ergonomics::TaskInput input;
+          const double load = handLoadKg(hands[k]);
+          input.load_kg = std::isfinite(load) ? load : 0.0;
+          a.rula[k] = ergonomics::scoreRula(a.angles, side, input);
+          a.reba[k] = ergonomics::scoreReba(a.angles, side, input);
+          if (world.physics()) {
+            const double n = hands[k].norm();
+            e.hand_force_sum_n[k] += n;
+            e.hand_force_max_n[k] = std::max(e.hand_force_max_n[k], n);
+            e.hand_load_max_kg[k] = std::max(e.hand_load_max_kg[k], input.load_kg);
+          }
+        }
+        if (world.physics()) ++e.hand_force_samples;
         const int rula = std::max(a.rula[0].grand, a.rula[1].grand), reba = std::max(a.reba[0].score, a.reba[1].score);
         e.rula_max = std::max(e.rula_max, rula);
         e.reba_max = std::max(e.reba_max, reba);

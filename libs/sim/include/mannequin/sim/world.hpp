@@ -24,6 +24,7 @@
 /// tracked pose for `occlusion_hold` s, then the frame's weight decreases linearly to 0 over
 /// `occlusion_blend` s, so the posture control takes the limb back to the posture target; when the body
 /// is tracked again the weight rises back to 1 over `occlusion_blend` s (no jump).
+#include <array>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -165,6 +166,15 @@ struct SimConfig {
   /// tracker always clamps to the limits.
   std::optional<constraints::JointLimitOptions> joint_limits = constraints::JointLimitOptions{};
   PhysicsConfig physics;
+};
+
+/// A grasp held now (World::grasp), for reports.
+struct GraspState {
+  int handle = -1;     ///< World::grasp's handle
+  int mannequin = -1;
+  int joint = -1;      ///< joint of the mannequin's model carrying the grasping frame
+  int object = -1;     ///< object index
+  math::Vector3 force = math::Vector3::Zero();  ///< N, world: on the object at the last step (the hand gets −force)
 };
 
 /// One contact after a step's solve, for sim.world and diagnostics (world frame).
@@ -333,6 +343,13 @@ class World {
   /// Force (N, world) the grasp `handle` applied on its object at the last step (the hand gets the
   /// opposite); zero for an unknown handle.
   math::Vector3 graspForce(int handle) const;
+  /// The grasps held now, by handle (empty with physics off).
+  std::vector<GraspState> grasps() const;
+  /// Force (N, world) on each hand of mannequin m at the last step, [left, right]: the pull of what it
+  /// holds (−force of every grasp whose frame is carried by the joint of the segment "hand_l" / "hand_r")
+  /// plus the contacts on that segment, each as its normal force along the contact normal (friction,
+  /// reported as a magnitude only, is left out). Zero with physics off or without such a segment.
+  std::array<math::Vector3, 2> handForces(int m) const;
   /// Guides object i on a virtual mechanism (object_guides.hpp: rows of the LCP on the object alone,
   /// thesis 4.3.1: a tray kept level, a part kept on an axis), replacing a guide it had.
   /// \throws std::invalid_argument on physics off, an unknown object, a hinged object or a spec

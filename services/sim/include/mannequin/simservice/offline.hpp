@@ -22,11 +22,24 @@
 
 namespace mannequin::simservice {
 
+/// The load a hand force stands for in RULA's force/load and REBA's load/force scores: |F| / g₀ (kg-force,
+/// g₀ = 9.80665 m/s²), whatever its direction (the sheets score a load held and a force exerted alike).
+inline double handLoadKg(const math::Vector3& force_n) { return force_n.norm() / 9.80665; }
+
 /// Per mannequin, the postures' ergonomic scores over the run (RULA and REBA of the worse side, sampled
-/// at the world rate once calibrated; libs/ergonomics with its default task input: no load, not static,
-/// not repeated — what a capture cannot say).
+/// at the world rate once calibrated). libs/ergonomics' task input per side: the load in that hand from the
+/// World (sim::World::handForces: what it holds and the contacts on it; handLoadKg) with physics on, none
+/// without; not static, not repeated, good coupling — what a capture cannot say.
 struct ErgonomicsSummary {
   std::string mannequin;
+  /// Per hand [left, right], over the scored samples with physics on: |World::handForces| (N) summed and
+  /// its largest, the largest load (kg, handLoadKg) given to the scores.
+  std::array<double, 2> hand_force_sum_n{}, hand_force_max_n{}, hand_load_max_kg{};
+  long long hand_force_samples = 0;
+  double meanHandForce(int side) const {
+    return hand_force_samples > 0 ? hand_force_sum_n[static_cast<std::size_t>(side)] / static_cast<double>(hand_force_samples)
+                                  : std::numeric_limits<double>::quiet_NaN();
+  }
   int rula_max = 0, reba_max = 0;
   std::array<double, 4> rula_time_s{};  ///< at RULA action level 1..4
   std::array<double, 5> reba_time_s{};  ///< at REBA action level 0..4
