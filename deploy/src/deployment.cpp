@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <limits>
+#include <map>
 #include <set>
 #include <stdexcept>
 
@@ -21,10 +22,50 @@ std::string expandRunDir(const std::string& text, const std::string& run_dir) {
   return out;
 }
 
+std::string tcpHost(const std::string& endpoint) {
+  if (endpoint.rfind("tcp://", 0) != 0) return {};
+  const std::string rest = endpoint.substr(6);
+  return rest.substr(0, rest.rfind(':'));
+}
+
+bool isLoopbackHost(const std::string& host) {
+  return host.rfind("127.", 0) == 0 || host == "[::1]" || host == "::1" || host == "localhost" || host == "lo";
+}
+
+namespace {
+std::string tcpPort(const std::string& endpoint) {
+  const std::size_t colon = endpoint.rfind(':');
+  return colon == std::string::npos ? std::string() : endpoint.substr(colon + 1);
+}
+bool isWildcardHost(const std::string& host) { return host == "*" || host == "0.0.0.0" || host == "[::]" || host == "::"; }
+}  // namespace
+
+const Host* Deployment::findHost(const std::string& host) const {
+  for (const auto& h : hosts)
+    if (h.name == host) return &h;
+  return nullptr;
+}
+
+std::string Deployment::hostNames() const {
+  std::string out;
+  for (const auto& h : hosts) out += (out.empty() ? "" : ", ") + h.name;
+  return out;
+}
+
 const std::string& Deployment::endpointOf(const std::string& name) const {
   for (const auto& s : services)
     if (s.name == name) return s.publish;
   throw std::out_of_range("deployment '" + this->name + "': no service '" + name + "'");
+}
+
+const std::string& Deployment::addressOf(const std::string& name) const {
+  for (const auto& s : services)
+    if (s.name == name) return s.address;
+  throw std::out_of_range("deployment '" + this->name + "': no service '" + name + "'");
+}
+
+bool Deployment::runsOn(std::size_t i, const std::string& host) const {
+  return !multiHost() || services.at(i).host == host;
 }
 
 std::vector<std::string> Deployment::commandLine(std::size_t i) const {
@@ -32,7 +73,7 @@ std::vector<std::string> Deployment::commandLine(std::size_t i) const {
   std::vector<std::string> argv{s.exec, "--name", s.name, "--publish", s.publish};
   for (const auto& c : s.connect) {
     argv.push_back("--connect");
-    argv.push_back(endpointOf(c));
+    argv.push_back(addressOf(c));
   }
   argv.insert(argv.end(), s.args.begin(), s.args.end());
   return argv;
@@ -53,7 +94,7 @@ RestartOptions parseRestart(const ConfigNode& n, RestartOptions r) {
 }
 
 Deployment readDeployment(const ConfigNode& root, const std::string& run_dir) {
-  root.allowOnly({"name", "run_dir", "heartbeat_timeout", "stop_timeout", "restart", "services"});
+  root.allowOnly({"name", "run_dir", "heartbeat_timeout", "stop_timeout", "restart", "hosts", "services"});
   Deployment d;
   d.source = root.file();
   d.name = root["name"].str();
@@ -64,15 +105,40 @@ Deployment readDeployment(const ConfigNode& root, const std::string& run_dir) {
   d.stop_timeout = root.getIn("stop_timeout", 3.0, 0.05, 600.0);
   RestartOptions defaults;
   if (auto r = root.find("restart")) defaults = parseRestart(*r, defaults);
+  if (const auto hosts = root.find("hosts")) {
+    for (const ConfigNode& h : hosts->items()) {
+      h.allowOnly({"name", "address"});
+      Host host;
+      host.line = h.line();
+      host.name = h["name"].str();
+      if (host.name.empty() || host.name.find_first_of(" /@") != std::string::npos) h["name"].fail("not a usable host name");
+      if (d.findHost(host.name)) h["name"].fail("duplicate host name '" + host.name + "'");
+      host.address = h["address"].str();
+      if (host.address.empty() || host.address.find_first_of(" /") != std::string::npos || host.address.find("://") != std::string::npos)
+        h["address"].fail("expected an IP address or a DNS name, got '" + host.address + "'");
+      d.hosts.push_back(host);
+    }
+    if (d.hosts.empty()) hosts->fail("no hosts (a single-host deployment has no 'hosts' key)");
+  }
   std::set<std::string> names;
+  std::map<std::string, std::string> bound;  // "host|tcp port" or "host|endpoint" → service
   const ConfigNode services = root["services"];
   for (const ConfigNode& s : services.items()) {
-    s.allowOnly({"name", "exec", "args", "publish", "connect", "restart"});
+    s.allowOnly({"name", "host", "exec", "args", "publish", "connect", "restart"});
     ServiceSpec spec;
     spec.line = s.line();
     spec.name = s["name"].str();
     if (spec.name.empty() || spec.name.find_first_of(" /") != std::string::npos) s["name"].fail("not a usable service name");
     if (!names.insert(spec.name).second) s["name"].fail("duplicate service name '" + spec.name + "'");
+    const Host* host = nullptr;
+    if (auto h = s.find("host")) {
+      if (!d.multiHost()) h->fail("this deployment has no 'hosts' (a single-host deployment runs every service here)");
+      spec.host = h->str();
+      host = d.findHost(spec.host);
+      if (host == nullptr) h->fail("unknown host '" + spec.host + "' (hosts: " + d.hostNames() + ")");
+    } else if (d.multiHost()) {
+      s.fail("service '" + spec.name + "' is on no host: a multi-host deployment needs 'host' (one of " + d.hostNames() + ")");
+    }
     spec.exec = s["exec"].str();
     if (auto a = s.find("args"))
       for (const std::string& x : a->strings()) spec.args.push_back(expandRunDir(x, d.run_dir));
@@ -84,6 +150,27 @@ Deployment readDeployment(const ConfigNode& root, const std::string& run_dir) {
     } catch (const std::exception& e) {
       pub.fail(e.what());
     }
+    const std::string bind_host = tcpHost(spec.publish);
+    spec.address = spec.publish;
+    if (host == nullptr) {
+      if (!bind_host.empty() && !isLoopbackHost(bind_host))
+        pub.fail("'" + spec.publish + "' is reachable from other machines: a deployment without 'hosts' binds ipc or loopback "
+                 "tcp only (127.0.0.1, [::1], localhost); across machines declare hosts and security (docs/cluster.md)");
+    } else {
+      if (bind_host.empty())
+        pub.fail("a service of a multi-host deployment publishes on tcp (tcp://*:PORT): the other hosts' launchers follow "
+                 "its heartbeats, got '" + spec.publish + "'");
+      if (isLoopbackHost(bind_host))
+        pub.fail("'" + spec.publish + "' is loopback only: the other hosts cannot reach it (bind tcp://*:PORT)");
+      if (isWildcardHost(bind_host)) {
+        const bool v6 = host->address.find(':') != std::string::npos;
+        spec.address = "tcp://" + (v6 ? "[" + host->address + "]" : host->address) + ":" + tcpPort(spec.publish);
+      }
+    }
+    const std::string key = spec.host + "|" + (bind_host.empty() ? spec.publish : "tcp port " + tcpPort(spec.publish));
+    if (const auto [it, fresh] = bound.emplace(key, spec.name); !fresh)
+      pub.fail("'" + spec.publish + "' is already bound by service '" + it->second + "'" +
+               (spec.host.empty() ? std::string() : " on host '" + spec.host + "'"));
     if (auto c = s.find("connect")) spec.connect = c->strings();
     spec.restart = defaults;
     if (auto r = s.find("restart")) spec.restart = parseRestart(*r, defaults);

@@ -4,6 +4,8 @@
 #include "mannequin/deploy/deployment.hpp"
 #include "mannequin/core/config.hpp"
 
+#include <map>
+
 using namespace mannequin::deploy;
 
 TEST(Deployment, CommandLinesConnectByServiceName) {
@@ -71,8 +73,107 @@ TEST(Deployment, ErrorsNameFileLineAndField) {
 }
 
 TEST(Deployment, ShippedDeploymentsParse) {
-  for (const char* f : {"configs/deployments/single-host.yaml", "configs/deployments/single-host-view.yaml"}) {
+  for (const char* f : {"configs/deployments/single-host.yaml", "configs/deployments/single-host-view.yaml",
+                        "configs/deployments/cave.yaml"}) {
     const Deployment d = loadDeployment(f);
     EXPECT_GE(d.services.size(), 1u) << f;
+    EXPECT_FALSE(d.multiHost()) << f;
   }
+  // the VR room: one mocap host, one sim host (sim + collision), four render hosts (a wall each)
+  const Deployment room = loadDeployment("configs/deployments/vr-room.yaml");
+  ASSERT_TRUE(room.multiHost());
+  EXPECT_EQ(room.hostNames(), "mocap-pc, sim-pc, render-front, render-left, render-right, render-floor");
+  std::map<std::string, std::vector<std::string>> on;
+  for (const ServiceSpec& s : room.services) on[s.host].push_back(s.name);
+  EXPECT_EQ(on["mocap-pc"], (std::vector<std::string>{"mocap"}));
+  EXPECT_EQ(on["sim-pc"], (std::vector<std::string>{"collision", "sim"}));
+  for (const char* wall : {"front", "left", "right", "floor"})
+    EXPECT_EQ(on[std::string("render-") + wall], (std::vector<std::string>{std::string("wall_") + wall}));
+  EXPECT_EQ(room.addressOf("sim"), "tcp://10.0.0.11:5603");
+}
+
+namespace {
+const char* kTwoHosts = R"(name: room
+hosts:
+  - {name: a, address: 10.1.0.1}
+  - {name: b, address: fe80::2}
+services:
+  - name: mocap
+    host: a
+    exec: mannequin-mocap
+    publish: tcp://*:5601
+  - name: sim
+    host: b
+    exec: mannequin-sim
+    publish: tcp://0.0.0.0:5601
+    connect: [mocap, render]
+  - name: render
+    host: a
+    exec: mannequin-render
+    publish: tcp://10.1.0.1:5602
+    connect: [sim]
+)";
+}  // namespace
+
+TEST(Deployment, MultiHostServicesBindOnTheirHostAndTheOthersConnectToItsAddress) {
+  const Deployment d = parseDeployment(kTwoHosts, "room.yaml");
+  ASSERT_EQ(d.hosts.size(), 2u);
+  EXPECT_EQ(d.services[0].publish, "tcp://*:5601");
+  EXPECT_EQ(d.services[0].address, "tcp://10.1.0.1:5601");
+  EXPECT_EQ(d.services[1].address, "tcp://[fe80::2]:5601");  // an IPv6 host address in brackets
+  EXPECT_EQ(d.services[2].address, "tcp://10.1.0.1:5602");   // bound on one interface: as written
+  // binds its own endpoint, connects to the others' addresses
+  EXPECT_EQ(d.commandLine(1), (std::vector<std::string>{"mannequin-sim", "--name", "sim", "--publish", "tcp://0.0.0.0:5601",
+                                                        "--connect", "tcp://10.1.0.1:5601", "--connect", "tcp://10.1.0.1:5602"}));
+  EXPECT_TRUE(d.runsOn(0, "a"));
+  EXPECT_FALSE(d.runsOn(1, "a"));
+  EXPECT_TRUE(d.runsOn(1, "b"));
+  // a single-host deployment runs everything here, connecting where it binds
+  const Deployment single = parseDeployment("name: x\nservices:\n  - {name: a, exec: b, publish: 'tcp://127.0.0.1:7001'}\n", "x.yaml");
+  EXPECT_TRUE(single.runsOn(0, ""));
+  EXPECT_EQ(single.services[0].address, "tcp://127.0.0.1:7001");
+}
+
+TEST(Deployment, SingleHostBindsIpcOrLoopbackOnly) {
+  for (const char* ok : {"ipc:///tmp/a", "tcp://127.0.0.1:7001", "tcp://localhost:7001", "tcp://[::1]:7001", "tcp://lo:7001"})
+    EXPECT_NO_THROW(parseDeployment(std::string("name: x\nservices:\n  - {name: a, exec: b, publish: '") + ok + "'}\n", "x.yaml"))
+        << ok;
+  for (const char* open : {"tcp://*:7001", "tcp://0.0.0.0:7001", "tcp://10.0.0.1:7001", "tcp://eth0:7001", "tcp://[::]:7001"}) {
+    try {
+      parseDeployment(std::string("name: x\nservices:\n  - {name: a, exec: b, publish: '") + open + "'}\n", "x.yaml");
+      ADD_FAILURE() << open << " accepted in a single-host deployment";
+    } catch (const mannequin::core::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find("x.yaml:3: field 'services[0].publish': '" + std::string(open) +
+                                           "' is reachable from other machines"),
+                std::string::npos)
+          << e.what();
+    }
+  }
+}
+
+TEST(Deployment, MultiHostErrorsNameFileLineAndField) {
+  auto expectError = [](std::string yaml, const std::string& from, const std::string& to, const std::string& what) {
+    const auto at = yaml.find(from);
+    ASSERT_NE(at, std::string::npos) << from;
+    yaml.replace(at, from.size(), to);
+    try {
+      parseDeployment(yaml, "room.yaml");
+      ADD_FAILURE() << "no error for\n" << yaml;
+    } catch (const mannequin::core::ConfigError& e) {
+      EXPECT_NE(std::string(e.what()).find(what), std::string::npos) << e.what();
+    }
+  };
+  expectError(kTwoHosts, "    host: b\n", "    host: c\n", "room.yaml:11: field 'services[1].host': unknown host 'c' (hosts: a, b)");
+  expectError(kTwoHosts, "    host: b\n", "", "room.yaml:10: field 'services[1]': service 'sim' is on no host");
+  expectError(kTwoHosts, "{name: b, address", "{name: a, address", "room.yaml:4: field 'hosts[1].name': duplicate host name 'a'");
+  expectError(kTwoHosts, "address: 10.1.0.1}", "address: 'tcp://10.1.0.1'}", "field 'hosts[0].address': expected an IP address");
+  expectError(kTwoHosts, "name: sim\n", "name: mocap\n", "room.yaml:10: field 'services[1].name': duplicate service name 'mocap'");
+  expectError(kTwoHosts, "tcp://*:5601", "ipc:///tmp/mocap", "field 'services[0].publish': a service of a multi-host deployment publishes on tcp");
+  expectError(kTwoHosts, "tcp://*:5601", "tcp://127.0.0.1:5601", "'tcp://127.0.0.1:5601' is loopback only");
+  expectError(kTwoHosts, "tcp://10.1.0.1:5602", "tcp://10.1.0.1:5601",
+              "room.yaml:18: field 'services[2].publish': 'tcp://10.1.0.1:5601' is already bound by service 'mocap' on host 'a'");
+  expectError(kTwoHosts, "hosts:\n  - {name: a, address: 10.1.0.1}\n  - {name: b, address: fe80::2}\n", "hosts: []\n",
+              "room.yaml:2: field 'hosts': no hosts");
+  expectError("name: x\nservices:\n  - {name: a, host: h, exec: b, publish: 'ipc:///a'}\n", "name: x", "name: x",
+              "room.yaml:3: field 'services[0].host': this deployment has no 'hosts'");
 }
