@@ -18,13 +18,14 @@ int main(int argc, char** argv) {
                "--host), prefixes their output, shows a status line from the heartbeats of every service of the\n"
                "deployment (services up, rates, lateness), restarts a crashed service with backoff, and stops all\n"
                "cleanly on Ctrl-C / SIGTERM / --duration. A bad deployment file is FILE:LINE and exit 2."};
-  std::string file, run_dir, summary_json, host;
+  std::string file, run_dir, summary_json, host, key_dir;
   double duration = 0, status_period = 5.0;
   bool check = false, no_tty = false;
   app.add_option("deployment", file, "deployment file (YAML), e.g. configs/deployments/single-host.yaml")
       ->required()
       ->check(CLI::ExistingFile);
   app.add_option("--host", host, "multi-host deployment: the host this launcher runs (its services are started here)");
+  app.add_option("--key-dir", key_dir, "directory of the CURVE key files, instead of the deployment's security.key_dir");
   app.add_option("--duration", duration, "stop everything after this many seconds (0: until Ctrl-C/SIGTERM)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
@@ -48,6 +49,11 @@ int main(int argc, char** argv) {
         throw core::ConfigError(file + ": --host " + host + ": a single-host deployment has no 'hosts'");
       if (loaded->multiHost() && host.empty() && !check)
         throw core::ConfigError(file + ": a multi-host deployment: give --host NAME (hosts: " + loaded->hostNames() + ")");
+      if (!key_dir.empty()) {
+        if (!loaded->security) throw core::ConfigError(file + ": --key-dir: this deployment has no 'security'");
+        loaded->security->key_dir = std::filesystem::absolute(key_dir).lexically_normal().string();
+      }
+      deploy::checkKeys(*loaded, host);  // this host's secrets (--check without --host: every host's)
     } catch (const core::ConfigError& e) {
       std::cerr << "mannequin-launch: " << e.what() << '\n';
       return core::kExitUsage;
@@ -55,6 +61,7 @@ int main(int argc, char** argv) {
     const deploy::Deployment& d = *loaded;
     if (check) {
       std::cout << "deployment " << d.name << " (" << d.services.size() << " services, run dir " << d.run_dir << ")\n";
+      if (d.security) std::cout << "  security: CURVE, keys in " << d.security->key_dir << " (checked)\n";
       for (const auto& h : d.hosts) std::cout << "  host " << h.name << " at " << h.address << (h.name == host ? " (this host)" : "") << '\n';
       for (std::size_t i = 0; i < d.services.size(); ++i) {
         const deploy::ServiceSpec& s = d.services[i];

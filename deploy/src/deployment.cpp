@@ -2,6 +2,7 @@
 
 #include <unistd.h>
 
+#include <filesystem>
 #include <limits>
 #include <map>
 #include <set>
@@ -75,8 +76,120 @@ std::vector<std::string> Deployment::commandLine(std::size_t i) const {
     argv.push_back("--connect");
     argv.push_back(addressOf(c));
   }
+  if (security) {
+    argv.push_back("--security");
+    argv.push_back(securityFile(i));
+  }
   argv.insert(argv.end(), s.args.begin(), s.args.end());
   return argv;
+}
+
+std::string Deployment::publicKeyFile(const std::string& key_name) const {
+  return (std::filesystem::path(security.value().key_dir) / (key_name + ".key")).string();
+}
+
+std::string Deployment::secretKeyFile(const std::string& key_name) const {
+  return (std::filesystem::path(security.value().key_dir) / (key_name + ".key_secret")).string();
+}
+
+std::string Deployment::launcherKeyName(const std::string& host) { return host.empty() ? "launch" : "launch." + host; }
+
+std::string Deployment::securityFile(std::size_t i) const {
+  return (std::filesystem::path(run_dir) / "security" / (services.at(i).name + ".yaml")).string();
+}
+
+namespace {
+// a YAML double-quoted scalar
+std::string quoted(const std::string& text) {
+  std::string out = "\"";
+  for (char c : text) {
+    if (c == '"' || c == '\\') out += '\\';
+    out += c;
+  }
+  return out + "\"";
+}
+
+// every key name a publisher admits: the services, every launcher, the clients
+std::vector<std::string> admittedKeyNames(const Deployment& d) {
+  std::vector<std::string> names;
+  for (const auto& s : d.services) names.push_back(s.name);
+  if (d.multiHost())
+    for (const auto& h : d.hosts) names.push_back(Deployment::launcherKeyName(h.name));
+  else
+    names.push_back(Deployment::launcherKeyName(""));
+  for (const auto& c : d.security.value().clients) names.push_back(c);
+  return names;
+}
+}  // namespace
+
+std::string Deployment::securityFileText(std::size_t i) const {
+  const ServiceSpec& s = services.at(i);
+  std::string out = "# written by mannequin-launch from " + source + " for service '" + s.name + "'" +
+                    (s.host.empty() ? std::string() : " (host " + s.host + ")") + "\nsecurity:\n";
+  out += "  secret_key_file: " + quoted(secretKeyFile(s.name)) + "\n";
+  out += "  public_key_file: " + quoted(publicKeyFile(s.name)) + "\n";
+  if (!s.connect.empty()) {
+    out += "  servers:\n";
+    for (const std::string& c : s.connect)
+      out += "    - {connect: " + quoted(addressOf(c)) + ", public_key_file: " + quoted(publicKeyFile(c)) + "}\n";
+  }
+  out += "  authorized_keys:\n";
+  for (const std::string& k : admittedKeyNames(*this)) out += "    - " + quoted(publicKeyFile(k)) + "\n";
+  return out;
+}
+
+transport::CurveClientOptions Deployment::clientKeys(const std::string& secret_key_file) const {
+  transport::CurveClientOptions c;
+  c.secret_key = transport::readKeyFile(secret_key_file, true);
+  c.public_key = transport::curvePublicKey(c.secret_key);
+  for (const auto& s : services) c.server_keys[s.address] = transport::readKeyFile(publicKeyFile(s.name), false);
+  return c;
+}
+
+void checkKeys(const Deployment& d, const std::string& host) {
+  if (!d.security) return;
+  const std::string& where = d.security->where;
+  auto fail = [&](const std::string& file, const std::string& message, const std::string& whose) {
+    const bool missing = !std::filesystem::exists(file);
+    core::failAt(where, "security.key_dir",
+                 message + " (" + whose +
+                     (missing ? "; generate it with: mannequin-keys generate " + std::filesystem::path(file).stem().string() +
+                                    " --dir " + d.security->key_dir
+                              : std::string()) +
+                     ")");
+  };
+  auto read = [&](const std::string& key_name, bool secret, const std::string& whose) {
+    const std::string file = secret ? d.secretKeyFile(key_name) : d.publicKeyFile(key_name);
+    try {
+      return transport::readKeyFile(file, secret);
+    } catch (const std::exception& e) {
+      fail(file, e.what(), whose);
+    }
+    return std::string();  // not reached: fail throws
+  };
+  auto whoseKey = [&](const std::string& key_name) -> std::string {
+    for (const auto& s : d.services)
+      if (s.name == key_name) return "the key of service '" + s.name + "'" + (s.host.empty() ? "" : " on host " + s.host);
+    for (const auto& c : d.security->clients)
+      if (c == key_name) return "the key of client '" + c + "'";
+    return "the key of the launcher" + (key_name.size() > 7 ? " of host " + key_name.substr(7) : std::string());
+  };
+  std::map<std::string, std::string> publics;  // key name → public key
+  for (const std::string& k : admittedKeyNames(d)) publics[k] = read(k, false, "the public " + whoseKey(k).substr(4));
+  // the secrets of this host (every host's when none is given)
+  std::vector<std::string> secrets;
+  for (std::size_t i = 0; i < d.services.size(); ++i)
+    if (host.empty() || d.runsOn(i, host)) secrets.push_back(d.services[i].name);
+  if (!d.multiHost())
+    secrets.push_back(Deployment::launcherKeyName(""));
+  else
+    for (const auto& h : d.hosts)
+      if (host.empty() || h.name == host) secrets.push_back(Deployment::launcherKeyName(h.name));
+  for (const std::string& k : secrets) {
+    const std::string secret = read(k, true, "the secret " + whoseKey(k).substr(4));
+    if (transport::curvePublicKey(secret) != publics[k])
+      fail(d.secretKeyFile(k), d.secretKeyFile(k) + ": not the secret key of " + d.publicKeyFile(k), whoseKey(k));
+  }
 }
 
 namespace {
@@ -94,7 +207,7 @@ RestartOptions parseRestart(const ConfigNode& n, RestartOptions r) {
 }
 
 Deployment readDeployment(const ConfigNode& root, const std::string& run_dir) {
-  root.allowOnly({"name", "run_dir", "heartbeat_timeout", "stop_timeout", "restart", "hosts", "services"});
+  root.allowOnly({"name", "run_dir", "heartbeat_timeout", "stop_timeout", "restart", "hosts", "security", "services"});
   Deployment d;
   d.source = root.file();
   d.name = root["name"].str();
@@ -119,6 +232,27 @@ Deployment readDeployment(const ConfigNode& root, const std::string& run_dir) {
       d.hosts.push_back(host);
     }
     if (d.hosts.empty()) hosts->fail("no hosts (a single-host deployment has no 'hosts' key)");
+  }
+  if (const auto sec = root.find("security")) {
+    sec->allowOnly({"key_dir", "clients"});
+    DeploymentSecurity security;
+    const ConfigNode dir = (*sec)["key_dir"];
+    std::filesystem::path key_dir(dir.str());
+    if (key_dir.empty()) dir.fail("empty path");
+    if (key_dir.is_relative()) key_dir = std::filesystem::path(root.file()).parent_path() / key_dir;
+    security.key_dir = std::filesystem::absolute(key_dir).lexically_normal().string();
+    security.where = dir.where();
+    if (auto c = sec->find("clients")) {
+      for (const ConfigNode& client : c->items()) {
+        const std::string name = client.str();
+        if (name.empty() || name.find_first_of(" /") != std::string::npos) client.fail("not a usable key name");
+        security.clients.push_back(name);
+      }
+    }
+    if (!transport::hasCurve()) sec->fail("this libzmq has no CURVE support");
+    d.security = security;
+  } else if (d.multiHost()) {
+    root["hosts"].fail("a multi-host deployment needs 'security' (CURVE: key_dir, clients; docs/cluster.md)");
   }
   std::set<std::string> names;
   std::map<std::string, std::string> bound;  // "host|tcp port" or "host|endpoint" → service

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <thread>
 
@@ -127,10 +128,40 @@ int Supervisor::run(const std::atomic<bool>& stop) {
     return 1;
   }
   chmod(deployment_.run_dir.c_str(), 0700);
+  std::vector<std::string> security_files;  // removed at the end
+  std::optional<transport::CurveClientOptions> monitor_keys;
+  if (deployment_.security) {
+    // each local service's keys (--security RUN_DIR/security/NAME.yaml), the monitor's own
+    const std::filesystem::path dir = std::filesystem::path(deployment_.run_dir) / "security";
+    std::filesystem::create_directories(dir, ec);
+    chmod(dir.c_str(), 0700);
+    for (std::size_t i = 0; i < deployment_.services.size() && !ec; ++i) {
+      if (!status_[i].local) continue;
+      const std::string file = deployment_.securityFile(i);
+      std::ofstream f(file, std::ios::trunc);
+      f << deployment_.securityFileText(i);
+      f.close();
+      if (!f) {
+        out.launcher(fmt::format("cannot write {}", file));
+        return 1;
+      }
+      security_files.push_back(file);
+    }
+    if (ec) {
+      out.launcher(fmt::format("cannot create {}: {}", dir.string(), ec.message()));
+      return 1;
+    }
+    try {
+      monitor_keys = deployment_.clientKeys(deployment_.secretKeyFile(Deployment::launcherKeyName(options_.host)));
+    } catch (const std::exception& e) {
+      out.launcher(fmt::format("the launcher's keys: {}", e.what()));
+      return 1;
+    }
+  }
 
   std::vector<std::string> endpoints;  // every service's, this host's and the others' (the whole room)
   for (const auto& s : deployment_.services) endpoints.push_back(s.address);
-  impl_->heartbeats = std::make_unique<HeartbeatMonitor>(impl_->context, endpoints);
+  impl_->heartbeats = std::make_unique<HeartbeatMonitor>(impl_->context, endpoints, monitor_keys);
   ProcessBackend& backend = *impl_->backend;
 
   auto start = [&](std::size_t i) {
@@ -315,6 +346,8 @@ int Supervisor::run(const std::atomic<bool>& stop) {
   }
   impl_->heartbeats->poll(status_);
   for (std::size_t i = 0; i < status_.size(); ++i) drain(i);
+  for (const std::string& f : security_files) std::filesystem::remove(f, ec);
+  if (deployment_.security) std::filesystem::remove(std::filesystem::path(deployment_.run_dir) / "security", ec);
   std::filesystem::remove(deployment_.run_dir, ec);  // only if empty
   publishSnapshot();
 

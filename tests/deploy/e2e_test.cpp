@@ -25,6 +25,7 @@
 #include "../common/child_process.hpp"
 #include "mannequin/core/process.hpp"
 #include "mannequin/transport/publisher.hpp"
+#include "mannequin/transport/security.hpp"
 #include "mannequin/transport/subscriber.hpp"
 
 using namespace mannequin;
@@ -56,7 +57,9 @@ int freePort() {
 
 // The same multi-host deployment run by two launchers (hosts a and b, both this machine's loopback):
 // each starts only its host's service (binding tcp://*:PORT) and shows the other's from its heartbeats
-// ("2/2 up"); the other's is in its summary as on host b, not started here (no pid, no start).
+// ("2/2 up"); the other's is in its summary as on host b, not started here (no pid, no start). CURVE:
+// the launchers' monitors are CURVE clients, so "up" means the services took the keys the launcher
+// gave them; a missing key file is refused before anything starts (exit 2, FILE:LINE).
 TEST(EndToEnd, TwoLaunchersOfOneMultiHostDeploymentEachStartTheirShareAndSeeTheWholeRoom) {
   const auto dir = std::filesystem::temp_directory_path() / ("mq-e2e-hosts-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
@@ -68,6 +71,7 @@ TEST(EndToEnd, TwoLaunchersOfOneMultiHostDeploymentEachStartTheirShareAndSeeTheW
   {
     std::ofstream out(deployment);
     out << "name: room\nheartbeat_timeout: 2.0\nhosts:\n  - {name: a, address: 127.0.0.1}\n  - {name: b, address: 127.0.0.1}\n"
+           "security: {key_dir: keys}\n"
            "services:\n"
            "  - name: mocap_a\n    host: a\n    exec: mannequin-mocap\n"
            "    args: [--config, configs/sim/mocap_synthetic.yaml, --heartbeat-period, '0.2']\n"
@@ -75,6 +79,19 @@ TEST(EndToEnd, TwoLaunchersOfOneMultiHostDeploymentEachStartTheirShareAndSeeTheW
            "  - name: mocap_b\n    host: b\n    exec: mannequin-mocap\n"
            "    args: [--config, configs/sim/mocap_synthetic.yaml, --heartbeat-period, '0.2']\n"
            "    publish: tcp://0.0.0.0:" << port_b << "\n";
+  }
+  // keys: none yet → refused before anything starts
+  const std::string check_log = (dir / "check.log").string();
+  const pid_t check = testutil::spawnProcess({std::string(MANNEQUIN_BIN_DIR) + "/mannequin-launch", deployment, "--host", "a", "--check"},
+                                             check_log);
+  EXPECT_EQ(testutil::waitExit(check, "mannequin-launch --check without keys", std::chrono::seconds(20)), 2) << readFile(check_log);
+  EXPECT_NE(readFile(check_log).find(deployment + ":6: field 'security.key_dir': " + (dir / "keys").string()), std::string::npos)
+      << readFile(check_log);
+  std::filesystem::create_directories(dir / "keys");
+  for (const char* n : {"mocap_a", "mocap_b", "launch.a", "launch.b"}) {
+    const auto k = transport::generateCurveKeyPair();
+    transport::writeKeyFile((dir / "keys" / (std::string(n) + ".key_secret")).string(), k.secret_key, "secret", 0600);
+    transport::writeKeyFile((dir / "keys" / (std::string(n) + ".key")).string(), k.public_key, "public", 0644);
   }
   struct Launcher {
     std::string host, log, summary;
