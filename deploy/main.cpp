@@ -1,27 +1,31 @@
-// mannequin-launch: runs every service of a deployment file on this host (see docs/cluster.md).
+// mannequin-launch: runs the services of a deployment file on this host (see docs/cluster.md).
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
 #include <filesystem>
 #include <fstream>
 #include <iostream>
+#include <optional>
 
+#include "mannequin/core/config.hpp"
 #include "mannequin/core/main.hpp"
 #include "mannequin/deploy/supervisor.hpp"
-#include "mannequin/core/config.hpp"
 
 using namespace mannequin;
 
 int main(int argc, char** argv) {
-  CLI::App app{"mannequin-launch: starts every service of a deployment file on this host, prefixes their\n"
-               "output, shows a status line from their heartbeats (services up, rates, lateness), restarts\n"
-               "a crashed service with backoff, and stops all cleanly on Ctrl-C / SIGTERM / --duration."};
-  std::string file, run_dir, summary_json;
+  CLI::App app{"mannequin-launch: starts the services of a deployment file on this host (multi-host: those of\n"
+               "--host), prefixes their output, shows a status line from the heartbeats of every service of the\n"
+               "deployment (services up, rates, lateness), restarts a crashed service with backoff, and stops all\n"
+               "cleanly on Ctrl-C / SIGTERM / --duration. A bad deployment file is FILE:LINE and exit 2."};
+  std::string file, run_dir, summary_json, host, key_dir;
   double duration = 0, status_period = 5.0;
   bool check = false, no_tty = false;
   app.add_option("deployment", file, "deployment file (YAML), e.g. configs/deployments/single-host.yaml")
       ->required()
       ->check(CLI::ExistingFile);
+  app.add_option("--host", host, "multi-host deployment: the host this launcher runs (its services are started here)");
+  app.add_option("--key-dir", key_dir, "directory of the CURVE key files, instead of the deployment's security.key_dir");
   app.add_option("--duration", duration, "stop everything after this many seconds (0: until Ctrl-C/SIGTERM)")
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
@@ -31,26 +35,58 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--no-tty", no_tty, "print status lines instead of one live line even on a terminal");
   app.add_option("--summary-json", summary_json, "also write the final summary as JSON to this file");
-  app.add_flag("--check", check, "read the deployment, print the command lines, start nothing");
+  app.add_flag("--check", check,
+               "read and check the deployment, print the command lines (multi-host without --host: every host's), "
+               "start nothing");
   return core::runMain(app, argc, argv, [&] {
-    const deploy::Deployment d = deploy::loadDeployment(file, run_dir);
-    deploy::SupervisorOptions o;
-    o.exec_dir = std::filesystem::canonical("/proc/self/exe").parent_path().string();
-    o.tty = !no_tty && isatty(STDOUT_FILENO);
-    o.status_period = status_period;
-    o.duration = duration;
-    deploy::Supervisor supervisor(d, o);
+    const std::string exec_dir = std::filesystem::canonical("/proc/self/exe").parent_path().string();
+    std::optional<deploy::Deployment> loaded;
+    try {
+      loaded = deploy::loadDeployment(file, run_dir);
+      if (loaded->multiHost() && !host.empty() && !loaded->findHost(host))
+        throw core::ConfigError(file + ": --host " + host + ": no such host (hosts: " + loaded->hostNames() + ")");
+      if (!loaded->multiHost() && !host.empty())
+        throw core::ConfigError(file + ": --host " + host + ": a single-host deployment has no 'hosts'");
+      if (loaded->multiHost() && host.empty() && !check)
+        throw core::ConfigError(file + ": a multi-host deployment: give --host NAME (hosts: " + loaded->hostNames() + ")");
+      if (!key_dir.empty()) {
+        if (!loaded->security) throw core::ConfigError(file + ": --key-dir: this deployment has no 'security'");
+        loaded->security->key_dir = std::filesystem::absolute(key_dir).lexically_normal().string();
+      }
+      deploy::checkKeys(*loaded, host);  // this host's secrets (--check without --host: every host's)
+    } catch (const core::ConfigError& e) {
+      std::cerr << "mannequin-launch: " << e.what() << '\n';
+      return core::kExitUsage;
+    }
+    const deploy::Deployment& d = *loaded;
     if (check) {
       std::cout << "deployment " << d.name << " (" << d.services.size() << " services, run dir " << d.run_dir << ")\n";
+      if (d.security) std::cout << "  security: CURVE, keys in " << d.security->key_dir << " (checked)\n";
+      for (const auto& h : d.hosts) std::cout << "  host " << h.name << " at " << h.address << (h.name == host ? " (this host)" : "") << '\n';
       for (std::size_t i = 0; i < d.services.size(); ++i) {
+        const deploy::ServiceSpec& s = d.services[i];
         auto argv_s = d.commandLine(i);
-        argv_s[0] = supervisor.resolveExec(argv_s[0]);
-        std::cout << "  " << d.services[i].name << ":";
+        argv_s[0] = deploy::resolveExecutable(argv_s[0], exec_dir);
+        std::cout << "  " << s.name;
+        if (d.multiHost()) std::cout << " @" << s.host;
+        if (s.address != s.publish) std::cout << " (reached at " << s.address << ")";
+        if (!host.empty() && !d.runsOn(i, host)) {
+          std::cout << ": not started here\n";
+          continue;
+        }
+        std::cout << ":";
         for (const auto& a : argv_s) std::cout << ' ' << a;
         std::cout << '\n';
       }
       return 0;
     }
+    deploy::SupervisorOptions o;
+    o.exec_dir = exec_dir;
+    o.tty = !no_tty && isatty(STDOUT_FILENO);
+    o.status_period = status_period;
+    o.duration = duration;
+    o.host = host;
+    deploy::Supervisor supervisor(d, o);
     const auto& stop = core::installStopSignals();
     const int rc = supervisor.run(stop);
     std::cout << supervisor.summary() << std::flush;

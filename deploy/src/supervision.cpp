@@ -28,9 +28,11 @@ ServiceState liveness(bool has_heartbeat, std::int64_t last_heartbeat_ns, std::i
   return static_cast<double>(now_ns - started_ns) * 1e-9 > timeout_s ? ServiceState::kLate : ServiceState::kStarting;
 }
 
-HeartbeatMonitor::HeartbeatMonitor(zmq::context_t& context, const std::vector<std::string>& endpoints) {
+HeartbeatMonitor::HeartbeatMonitor(zmq::context_t& context, const std::vector<std::string>& endpoints,
+                                   std::optional<transport::CurveClientOptions> curve) {
   transport::SubscriberOptions so;
   so.name = "launch";
+  so.curve = std::move(curve);
   subscriber_ = std::make_unique<transport::Subscriber>(context, so);
   for (const std::string& e : endpoints) subscriber_->connect(e);
   subscriber_->subscribe(transport::topics::kHeartbeat, std::function<void(const v1::Heartbeat&)>([this](const v1::Heartbeat& hb) {

@@ -14,6 +14,7 @@
 #include <cmath>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
 #include <optional>
 #include <thread>
 
@@ -61,9 +62,19 @@ struct Supervisor::Impl {
 
 Supervisor::Supervisor(Deployment deployment, SupervisorOptions options)
     : impl_(std::make_unique<Impl>()), deployment_(std::move(deployment)), options_(std::move(options)) {
-  for (const auto& s : deployment_.services) {
+  if (deployment_.multiHost() && !deployment_.findHost(options_.host))
+    throw std::invalid_argument(deployment_.source + ": " +
+                                (options_.host.empty() ? std::string("a multi-host deployment: give the host this launcher runs")
+                                                       : "no host '" + options_.host + "'") +
+                                " (hosts: " + deployment_.hostNames() + ")");
+  if (!deployment_.multiHost() && !options_.host.empty())
+    throw std::invalid_argument(deployment_.source + ": a single-host deployment (no 'hosts'): no host '" + options_.host + "' to choose");
+  for (std::size_t i = 0; i < deployment_.services.size(); ++i) {
+    const ServiceSpec& s = deployment_.services[i];
     ServiceStatus st;
     st.name = s.name;
+    st.host = s.host;
+    st.local = deployment_.runsOn(i, options_.host);
     status_.push_back(st);
     impl_->name_width = std::max(impl_->name_width, s.name.size());
   }
@@ -87,10 +98,10 @@ Supervisor::~Supervisor() {
     if (c.fd >= 0) close(c.fd);
 }
 
-std::string Supervisor::resolveExec(const std::string& exec) const {
+std::string resolveExecutable(const std::string& exec, const std::string& exec_dir) {
   if (exec.find('/') != std::string::npos) return exec;
-  if (!options_.exec_dir.empty()) {
-    const auto p = std::filesystem::path(options_.exec_dir) / exec;
+  if (!exec_dir.empty()) {
+    const auto p = std::filesystem::path(exec_dir) / exec;
     if (access(p.c_str(), X_OK) == 0) return p.string();
   }
   if (const char* path = std::getenv("PATH")) {
@@ -106,6 +117,8 @@ std::string Supervisor::resolveExec(const std::string& exec) const {
   return exec;  // execv fails and the child reports it
 }
 
+std::string Supervisor::resolveExec(const std::string& exec) const { return resolveExecutable(exec, options_.exec_dir); }
+
 int Supervisor::run(const std::atomic<bool>& stop) {
   StatusPrinter out(options_.out, options_.tty, impl_->name_width);
   std::error_code ec;
@@ -115,10 +128,40 @@ int Supervisor::run(const std::atomic<bool>& stop) {
     return 1;
   }
   chmod(deployment_.run_dir.c_str(), 0700);
+  std::vector<std::string> security_files;  // removed at the end
+  std::optional<transport::CurveClientOptions> monitor_keys;
+  if (deployment_.security) {
+    // each local service's keys (--security RUN_DIR/security/NAME.yaml), the monitor's own
+    const std::filesystem::path dir = std::filesystem::path(deployment_.run_dir) / "security";
+    std::filesystem::create_directories(dir, ec);
+    chmod(dir.c_str(), 0700);
+    for (std::size_t i = 0; i < deployment_.services.size() && !ec; ++i) {
+      if (!status_[i].local) continue;
+      const std::string file = deployment_.securityFile(i);
+      std::ofstream f(file, std::ios::trunc);
+      f << deployment_.securityFileText(i);
+      f.close();
+      if (!f) {
+        out.launcher(fmt::format("cannot write {}", file));
+        return 1;
+      }
+      security_files.push_back(file);
+    }
+    if (ec) {
+      out.launcher(fmt::format("cannot create {}: {}", dir.string(), ec.message()));
+      return 1;
+    }
+    try {
+      monitor_keys = deployment_.clientKeys(deployment_.secretKeyFile(Deployment::launcherKeyName(options_.host)));
+    } catch (const std::exception& e) {
+      out.launcher(fmt::format("the launcher's keys: {}", e.what()));
+      return 1;
+    }
+  }
 
-  std::vector<std::string> endpoints;
-  for (const auto& s : deployment_.services) endpoints.push_back(s.publish);
-  impl_->heartbeats = std::make_unique<HeartbeatMonitor>(impl_->context, endpoints);
+  std::vector<std::string> endpoints;  // every service's, this host's and the others' (the whole room)
+  for (const auto& s : deployment_.services) endpoints.push_back(s.address);
+  impl_->heartbeats = std::make_unique<HeartbeatMonitor>(impl_->context, endpoints, monitor_keys);
   ProcessBackend& backend = *impl_->backend;
 
   auto start = [&](std::size_t i) {
@@ -218,7 +261,12 @@ int Supervisor::run(const std::atomic<bool>& stop) {
   };
 
   const std::int64_t t0 = transport::steadyNs();
-  for (std::size_t i = 0; i < deployment_.services.size(); ++i) start(i);
+  for (std::size_t i = 0; i < deployment_.services.size(); ++i) {
+    if (status_[i].local)
+      start(i);
+    else
+      impl_->children[i].started_ns = t0;  // another host's: late when no heartbeat within the timeout
+  }
   publishSnapshot();
   std::int64_t last_status = t0;
   std::vector<pollfd> fds;
@@ -247,7 +295,7 @@ int Supervisor::run(const std::atomic<bool>& stop) {
         st.restarts = c.restarts->restarts();
         start(i);
       }
-      if (st.pid > 0) {
+      if (st.pid > 0 || !st.local) {
         const ServiceState live = liveness(st.has_heartbeat, st.last_heartbeat_ns, c.started_ns, now, deployment_.heartbeat_timeout);
         if (live != ServiceState::kStarting) st.state = live;
       }
@@ -298,12 +346,14 @@ int Supervisor::run(const std::atomic<bool>& stop) {
   }
   impl_->heartbeats->poll(status_);
   for (std::size_t i = 0; i < status_.size(); ++i) drain(i);
+  for (const std::string& f : security_files) std::filesystem::remove(f, ec);
+  if (deployment_.security) std::filesystem::remove(std::filesystem::path(deployment_.run_dir) / "security", ec);
   std::filesystem::remove(deployment_.run_dir, ec);  // only if empty
   publishSnapshot();
 
   int rc = 0;
   for (const auto& st : status_)
-    if (st.state == ServiceState::kFailed || !st.clean_exit) rc = 1;
+    if (st.local && (st.state == ServiceState::kFailed || !st.clean_exit)) rc = 1;
   return rc;
 }
 
@@ -332,8 +382,13 @@ std::string Supervisor::summary() const {
   const std::vector<ServiceStatus> all = status();
   std::string s = fmt::format("summary of deployment '{}' ({})\n", deployment_.name, deployment_.source);
   for (const auto& st : all) {
-    s += fmt::format("  {:<{}} {:<10} starts {} restarts {} last {} heartbeats {}\n", st.name, impl_->name_width,
-                     toString(st.state), st.starts, st.restarts, st.last_exit.empty() ? "-" : st.last_exit, st.heartbeats);
+    if (st.local)
+      s += fmt::format("  {:<{}} {:<10} starts {} restarts {} last {} heartbeats {}{}\n", st.name, impl_->name_width,
+                       toString(st.state), st.starts, st.restarts, st.last_exit.empty() ? "-" : st.last_exit, st.heartbeats,
+                       st.host.empty() ? std::string() : " (host " + st.host + ")");
+    else
+      s += fmt::format("  {:<{}} {:<10} on host {} (not started here) heartbeats {}\n", st.name, impl_->name_width,
+                       toString(st.state), st.host, st.heartbeats);
     if (!st.has_heartbeat) continue;
     const auto& hb = st.heartbeat;
     s += fmt::format("  {:<{}} loop {:.1f} Hz, worst lateness {:.2f} ms, uptime {:.1f} s\n", "", impl_->name_width,
@@ -371,9 +426,9 @@ std::string Supervisor::summaryJson() const {
     std::string pids;
     for (pid_t p : st.pids) pids += (pids.empty() ? "" : ", ") + std::to_string(p);
     s += fmt::format("{}{{\"name\": {}, \"state\": {}, \"starts\": {}, \"restarts\": {}, \"last_exit\": {}, \"clean_exit\": {}, "
-                     "\"pids\": [{}], \"heartbeats\": {}",
+                     "\"pids\": [{}], \"heartbeats\": {}, \"host\": {}, \"local\": {}",
                      i ? ", " : "", q(st.name), q(toString(st.state)), st.starts, st.restarts, q(st.last_exit),
-                     st.clean_exit ? "true" : "false", pids, st.heartbeats);
+                     st.clean_exit ? "true" : "false", pids, st.heartbeats, q(st.host), st.local ? "true" : "false");
     if (st.has_heartbeat) {
       const auto& hb = st.heartbeat;
       s += fmt::format(", \"loop_rate_hz\": {}, \"worst_lateness_ms\": {}, \"topics\": [", num(hb.loop_rate_hz()),

@@ -31,11 +31,11 @@ int main(int argc, char** argv) {
       if (rate > 0) raw["bvh"]["rate"] = rate;
       if (loop || no_loop) raw["bvh"]["loop"] = !no_loop;
     });
-    config.allowOnly({"name", "publish", "source", "bvh", "c3d", "synthetic", "dtrack2"});
+    config.allowOnly({"name", "publish", "security", "source", "bvh", "c3d", "synthetic", "dtrack2"});
     const service::Endpoints ep = service::resolveEndpoints(common, config, "mocap");
     std::unique_ptr<mocap::Source> source = mocap::makeSource(config);
     zmq::context_t context;
-    transport::Publisher pub(context, {ep.name, ep.publish});
+    transport::Publisher pub(context, service::publisherOptions(ep));
     transport::HealthReporter health(pub, ep.name, nullptr, common.heartbeat_period);
     spdlog::info("{}: {} → mocap.frame on {}", ep.name, source->describe(), fmt::join(pub.boundEndpoints(), ", "));
     std::uint64_t frames = 0;

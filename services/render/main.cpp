@@ -32,6 +32,7 @@
 #include "mannequin/render/overlay.hpp"
 #include "mannequin/render/renderer.hpp"
 #include "mannequin/render/view.hpp"
+#include "mannequin/service/runtime.hpp"
 #include "mannequin/simservice/config.hpp"
 #include "mannequin/transport/health.hpp"
 #include "mannequin/transport/publisher.hpp"
@@ -54,6 +55,8 @@ struct Options {
   std::vector<std::string> connect;  // live sim.world publishers
   std::string name = "render";       // --name: heartbeat name (the launcher passes the service name)
   std::vector<std::string> publish;  // --publish: where heartbeats go (the launcher passes the endpoint)
+  std::string security;              // --security FILE: CURVE keys (a `security` section; the launcher writes one)
+  service::Security curve;           // its keys (unset: plaintext)
   double duration = 0;               // live: s of wall time (0: until SIGINT/SIGTERM or --frames)
   bool headless = false;
   bool overlay = false;  // --overlay: the text line (frame, render fps, sim lateness)
@@ -70,7 +73,9 @@ class NodeLink {
  public:
   explicit NodeLink(const Options& o) {
     if (o.publish.empty()) return;
-    pub_ = std::make_unique<transport::Publisher>(context_, transport::PublisherOptions{o.name, o.publish});
+    transport::PublisherOptions po{o.name, o.publish};
+    po.curve = o.curve.server;
+    pub_ = std::make_unique<transport::Publisher>(context_, po);
     health_ = std::make_unique<transport::HealthReporter>(*pub_, o.name);
     health_->setState(v1::SERVICE_STATE_RUNNING);
     health_->tick(true);
@@ -198,8 +203,9 @@ std::vector<v1::WorldState> readRecording(const std::string& path) {
 /// re-sends its last state to a late subscriber, so a node shows the current scene at once).
 class LiveWorld {
  public:
-  LiveWorld(zmq::context_t& context, const std::vector<std::string>& endpoints, const render::ViewConfig& view)
-      : sub_(context, transport::SubscriberOptions{"render", endpoints}) {
+  LiveWorld(zmq::context_t& context, const std::vector<std::string>& endpoints, const render::ViewConfig& view,
+            const std::optional<transport::CurveClientOptions>& curve)
+      : sub_(context, transport::SubscriberOptions{"render", endpoints, 1000, 10000, curve}) {
     if (view.sync) {
       // the swap barrier shows the leader's step: every state is kept (queue delivery), the last kRing by step
       static constexpr transport::Topic<v1::WorldState> kWorldQueued{transport::topics::kSimWorld.name,
@@ -339,7 +345,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       spdlog::error("{}: sync: true needs --publish ENDPOINT (the node's render.sync; mannequin-launch passes it)", view.source);
       return core::kExitUsage;
     }
-    LiveWorld live(link.context(), o.connect, view);
+    LiveWorld live(link.context(), o.connect, view, o.curve.client);
     const auto& stop = core::installStopSignals();
     const auto start = std::chrono::steady_clock::now();
     const auto over = [&] {
@@ -376,7 +382,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
     spdlog::info("swap barrier: {} peers at the end, {} drops", barrier.peers(), barrier.dropped());
   } else if (!o.connect.empty()) {
     // live: a frame per new state (every Nth), named by its arrival count, until --frames, --duration or a signal
-    LiveWorld live(link.context(), o.connect, view);
+    LiveWorld live(link.context(), o.connect, view, o.curve.client);
     const auto& stop = core::installStopSignals();
     const auto start = std::chrono::steady_clock::now();
     long long states = 0;
@@ -481,7 +487,7 @@ int runWindow(const Options& o, const render::ViewConfig& view, render::SceneAss
   std::vector<v1::WorldState> states;
   if (!o.from.empty()) states = readRecording(o.from);
   std::unique_ptr<LiveWorld> live;
-  if (!o.connect.empty()) live = std::make_unique<LiveWorld>(link.context(), o.connect, view);
+  if (!o.connect.empty()) live = std::make_unique<LiveWorld>(link.context(), o.connect, view, o.curve.client);
   std::set<std::string> tried;
   int rc = core::kExitOk;
   {
@@ -654,6 +660,10 @@ int main(int argc, char** argv) {
   app.add_option("--name", o.name, "node name (heartbeats; mannequin-launch passes the service name)")->capture_default_str();
   app.add_option("--publish", o.publish,
                  "publish heartbeats on this endpoint (repeatable; mannequin-launch passes the service's endpoint)");
+  app.add_option("--security", o.security,
+                 "YAML file with a 'security' section: CURVE keys of the node's publisher and subscriber (docs/cluster.md; "
+                 "mannequin-launch writes one per service of a deployment with security)")
+      ->check(CLI::ExistingFile);
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error, critical, off")->check(core::logLevelCheck());
   return core::runMain(app, argc, argv, [&] {
     core::setupLogging(log_level);
@@ -662,6 +672,7 @@ int main(int argc, char** argv) {
     try {
       view = render::loadView(core::findData(o.view));
       assets = loadAssets(o);
+      if (!o.security.empty()) o.curve = service::readSecurityFile(o.security, !o.connect.empty());
     } catch (const core::ConfigError& e) {
       spdlog::error("{}", e.what());
       return core::kExitUsage;

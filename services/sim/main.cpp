@@ -23,6 +23,8 @@ int main(int argc, char** argv) {
     config.name = ep.name;
     config.publish = ep.publish;
     config.connect = ep.connect;
+    config.curve_server = ep.security.server;
+    config.curve_client = ep.security.client;
     zmq::context_t context;
     simservice::SimService service(config, context, common.heartbeat_period);
     return service.run(stop, common.duration);

@@ -9,6 +9,9 @@
 #include <signal.h>
 #include <sys/wait.h>
 #include <unistd.h>
+#include <arpa/inet.h>
+#include <netinet/in.h>
+#include <sys/socket.h>
 
 #include <chrono>
 #include <cmath>
@@ -17,10 +20,12 @@
 #include <algorithm>
 #include <random>
 #include <sstream>
+#include <thread>
 
 #include "../common/child_process.hpp"
 #include "mannequin/core/process.hpp"
 #include "mannequin/transport/publisher.hpp"
+#include "mannequin/transport/security.hpp"
 #include "mannequin/transport/subscriber.hpp"
 
 using namespace mannequin;
@@ -32,7 +37,114 @@ std::string readFile(const std::string& p) {
   ss << in.rdbuf();
   return ss.str();
 }
+
+// A tcp port free on this host now (bound to port 0 and released), for a test deployment.
+int freePort() {
+  const int fd = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_ANY);
+  socklen_t len = sizeof(a);
+  if (fd < 0 || ::bind(fd, reinterpret_cast<sockaddr*>(&a), sizeof(a)) != 0 ||
+      ::getsockname(fd, reinterpret_cast<sockaddr*>(&a), &len) != 0) {
+    if (fd >= 0) ::close(fd);
+    return 0;
+  }
+  ::close(fd);
+  return ntohs(a.sin_port);
+}
 }  // namespace
+
+// The same multi-host deployment run by two launchers (hosts a and b, both this machine's loopback):
+// each starts only its host's service (binding tcp://*:PORT) and shows the other's from its heartbeats
+// ("2/2 up"); the other's is in its summary as on host b, not started here (no pid, no start). CURVE:
+// the launchers' monitors are CURVE clients, so "up" means the services took the keys the launcher
+// gave them; a missing key file is refused before anything starts (exit 2, FILE:LINE).
+TEST(EndToEnd, TwoLaunchersOfOneMultiHostDeploymentEachStartTheirShareAndSeeTheWholeRoom) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mq-e2e-hosts-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  const int port_a = freePort(), port_b = freePort();
+  ASSERT_GT(port_a, 0);
+  ASSERT_GT(port_b, 0);
+  ASSERT_NE(port_a, port_b);
+  const std::string deployment = (dir / "room.yaml").string();
+  {
+    std::ofstream out(deployment);
+    out << "name: room\nheartbeat_timeout: 2.0\nhosts:\n  - {name: a, address: 127.0.0.1}\n  - {name: b, address: 127.0.0.1}\n"
+           "security: {key_dir: keys}\n"
+           "services:\n"
+           "  - name: mocap_a\n    host: a\n    exec: mannequin-mocap\n"
+           "    args: [--config, configs/sim/mocap_synthetic.yaml, --heartbeat-period, '0.2']\n"
+           "    publish: tcp://*:" << port_a << "\n"
+           "  - name: mocap_b\n    host: b\n    exec: mannequin-mocap\n"
+           "    args: [--config, configs/sim/mocap_synthetic.yaml, --heartbeat-period, '0.2']\n"
+           "    publish: tcp://0.0.0.0:" << port_b << "\n";
+  }
+  // keys: none yet → refused before anything starts
+  const std::string check_log = (dir / "check.log").string();
+  const pid_t check = testutil::spawnProcess({std::string(MANNEQUIN_BIN_DIR) + "/mannequin-launch", deployment, "--host", "a", "--check"},
+                                             check_log);
+  EXPECT_EQ(testutil::waitExit(check, "mannequin-launch --check without keys", std::chrono::seconds(20)), 2) << readFile(check_log);
+  EXPECT_NE(readFile(check_log).find(deployment + ":6: field 'security.key_dir': " + (dir / "keys").string()), std::string::npos)
+      << readFile(check_log);
+  std::filesystem::create_directories(dir / "keys");
+  for (const char* n : {"mocap_a", "mocap_b", "launch.a", "launch.b"}) {
+    const auto k = transport::generateCurveKeyPair();
+    transport::writeKeyFile((dir / "keys" / (std::string(n) + ".key_secret")).string(), k.secret_key, "secret", 0600);
+    transport::writeKeyFile((dir / "keys" / (std::string(n) + ".key")).string(), k.public_key, "public", 0644);
+  }
+  struct Launcher {
+    std::string host, log, summary;
+    pid_t pid = -1;
+  };
+  std::vector<Launcher> launchers;
+  for (const char* host : {"a", "b"}) {
+    Launcher l{host, (dir / (std::string(host) + ".log")).string(), (dir / (std::string(host) + ".json")).string()};
+    l.pid = testutil::spawnProcess({std::string(MANNEQUIN_BIN_DIR) + "/mannequin-launch", deployment, "--host", host, "--run-dir",
+                                    (dir / ("run-" + std::string(host))).string(), "--status-period", "0.2", "--summary-json",
+                                    l.summary},
+                                   l.log);
+    launchers.push_back(l);
+  }
+  for (const Launcher& l : launchers) ASSERT_GT(l.pid, 0);
+  const auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  bool both_up = false;
+  while (!both_up && std::chrono::steady_clock::now() < deadline) {
+    both_up = true;
+    for (const Launcher& l : launchers) both_up = both_up && readFile(l.log).find("| 2/2 up | mocap_a") != std::string::npos;
+    std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  }
+  for (const Launcher& l : launchers) {
+    EXPECT_TRUE(both_up) << "within 30 s, launcher of host " << l.host << " never showed 2/2 up:\n" << readFile(l.log);
+    if (core::signalProcess(l.pid, SIGTERM) == core::SignalResult::kSent) {
+      EXPECT_EQ(testutil::waitExit(l.pid, "mannequin-launch --host " + l.host, std::chrono::seconds(20)), 0) << readFile(l.log);
+    } else {
+      ADD_FAILURE() << "launcher of host " << l.host << " (pid " << l.pid << ") was gone before SIGTERM:\n" << readFile(l.log);
+    }
+  }
+  for (const Launcher& l : launchers) {
+    const std::string json = readFile(l.summary);
+    const std::string mine = "mocap_" + l.host, other = l.host == "a" ? "mocap_b" : "mocap_a";
+    const auto at_mine = json.find("\"name\": \"" + mine + "\"");
+    const auto at_other = json.find("\"name\": \"" + other + "\"");
+    ASSERT_NE(at_mine, std::string::npos) << json;
+    ASSERT_NE(at_other, std::string::npos) << json;
+    const std::string entry_mine = json.substr(at_mine, json.find("\"local\"", at_mine) + 16 - at_mine);
+    const std::string entry_other = json.substr(at_other, json.find("\"local\"", at_other) + 16 - at_other);
+    EXPECT_NE(entry_mine.find("\"state\": \"stopped\", \"starts\": 1"), std::string::npos) << entry_mine;
+    EXPECT_NE(entry_mine.find("\"local\": true"), std::string::npos) << entry_mine;
+    EXPECT_NE(entry_other.find("\"starts\": 0"), std::string::npos) << entry_other;
+    EXPECT_NE(entry_other.find("\"pids\": []"), std::string::npos) << entry_other;
+    EXPECT_NE(entry_other.find("\"local\": false"), std::string::npos) << entry_other;
+    const auto hb = entry_other.find("\"heartbeats\": ");
+    ASSERT_NE(hb, std::string::npos) << entry_other;
+    EXPECT_GE(std::stoll(entry_other.substr(hb + 14)), 1) << entry_other;
+    EXPECT_NE(entry_other.find("\"state\": \"up\""), std::string::npos) << entry_other;  // from its heartbeats alone
+    EXPECT_NE(readFile(l.log).find("on host " + std::string(l.host == "a" ? "b" : "a") + " (not started here)"), std::string::npos)
+        << readFile(l.log);
+  }
+  std::filesystem::remove_all(dir);
+}
 
 TEST(EndToEnd, LauncherBvhDrivesTheMannequinAtRateAndStopsCleanly) {
   const auto dir = std::filesystem::temp_directory_path() / ("mq-e2e-" + std::to_string(getpid()));

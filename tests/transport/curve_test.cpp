@@ -254,3 +254,36 @@ TEST(CurveKeys, KeyFilesAreReadAndCheckedWithTheirName) {
   std::ofstream(empty) << "# only a comment\n";
   EXPECT_NE(message([&] { readKeyFile(empty, false); }).find(empty + ": no key"), std::string::npos);
 }
+
+TEST_F(Curve, OneSubscriberHearsPublishersOfDifferentKeysEachByItsEndpointsKey) {
+  // a deployment's services each have their own key pair: the sim connects to mocap and collision
+  start();
+  const CurveKeyPair second = generateCurveKeyPair();
+  Publisher pub2(ctx, curvePublisher("collision", second, {listed.public_key}));
+  SubscriberOptions o;
+  o.name = "sim";
+  o.curve = CurveClientOptions{listed.public_key, listed.secret_key, "", {{endpoint, server.public_key}}};
+  o.curve->server_keys[pub2.boundEndpoints().at(0)] = second.public_key;
+  o.endpoints = {endpoint, pub2.boundEndpoints().at(0)};
+  Subscriber both_sub(ctx, o);
+  int from_mocap = 0, from_collision = 0;
+  both_sub.subscribe(topics::kMocapFrame, std::function<void(const v1::MocapFrame&)>([&](const v1::MocapFrame& f) {
+                       from_mocap += f.header().source() == "mocap";
+                       from_collision += f.header().source() == "collision";
+                     }));
+  const auto until = Clock::now() + kDeadline;
+  for (int i = 1; (from_mocap < 10 || from_collision < 10) && Clock::now() < until; ++i) {
+    publishFrame(*pub, i);
+    publishFrame(pub2, i);
+    both_sub.poll(std::chrono::milliseconds(2));
+  }
+  EXPECT_GE(from_mocap, 10);
+  EXPECT_GE(from_collision, 10);
+  // an endpoint with no key (no default either) is refused at connect, naming it
+  try {
+    both_sub.connect("tcp://127.0.0.1:5998");
+    ADD_FAILURE() << "connected without a server key";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("no server public key for 'tcp://127.0.0.1:5998'"), std::string::npos) << e.what();
+  }
+}

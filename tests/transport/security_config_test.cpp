@@ -139,3 +139,40 @@ TEST_F(SecurityConfig, ConfiguredServicesTalkOverCurve) {
   EXPECT_GE(pub.curveAdmissions(), 1u);
   EXPECT_EQ(pub.curveRefusals(), 0u);
 }
+
+TEST_F(SecurityConfig, ASecurityFileGivesOneServerKeyPerPublisherAndReplacesTheConfigs) {
+  // what mannequin-launch writes: `servers` (each endpoint's key), passed with --security FILE
+  const std::string file = (dir.path() / "sim.security.yaml").string();
+  std::ofstream(file) << "security:\n  secret_key_file: keys/sim.key_secret\n  servers:\n"
+                         "    - {connect: 'tcp://10.0.0.1:5601', public_key_file: keys/mocap.key}\n"
+                         "    - {connect: 'tcp://10.0.0.2:5602', public_key_file: keys/render1.key}\n"
+                         "  authorized_keys: [keys/mocap.key]\n";
+  config_path = (dir.path() / "svc.yaml").string();
+  std::ofstream(config_path) << "publish: tcp://127.0.0.1:0\nconnect: [tcp://10.0.0.1:5601, tcp://10.0.0.2:5602]\n";
+  service::CommonOptions o;
+  o.config = config_path;
+  o.security = file;
+  const service::Endpoints e = service::resolveEndpoints(o, service::loadConfig(o), "svc");
+  const SubscriberOptions s = service::subscriberOptions(e);
+  ASSERT_TRUE(s.curve.has_value());
+  EXPECT_EQ(s.curve->server_public_key, "");
+  EXPECT_EQ(s.curve->server_keys, (std::map<std::string, std::string>{{"tcp://10.0.0.1:5601", pairs["mocap"].public_key},
+                                                                     {"tcp://10.0.0.2:5602", pairs["render1"].public_key}}));
+  EXPECT_EQ(service::publisherOptions(e).curve->authorized_keys, (std::vector<std::string>{pairs["mocap"].public_key}));
+  // errors name the security file's FILE:LINE
+  std::ofstream(file) << "security:\n  secret_key_file: keys/sim.key_secret\n  servers:\n"
+                         "    - {connect: 'tcp://10.0.0.1:5601', public_key_file: keys/none.key}\n  authorized_keys: []\n";
+  try {
+    service::resolveEndpoints(o, service::loadConfig(o), "svc");
+    ADD_FAILURE() << "a missing server key file was accepted";
+  } catch (const core::ConfigError& err) {
+    EXPECT_NE(std::string(err.what()).find(file + ":4: field 'security.servers[0].public_key_file'"), std::string::npos) << err.what();
+  }
+  std::ofstream(file) << "publish: x\n";
+  try {
+    service::resolveEndpoints(o, service::loadConfig(o), "svc");
+    ADD_FAILURE() << "a security file with another key was accepted";
+  } catch (const core::ConfigError& err) {
+    EXPECT_NE(std::string(err.what()).find(file + ":1: field 'publish': unknown key"), std::string::npos) << err.what();
+  }
+}

@@ -5,9 +5,11 @@
 
 #include <chrono>
 #include <map>
+#include <optional>
 #include <set>
 
 #include "cluster_io.hpp"
+#include "mannequin/deploy/deployment.hpp"
 #include "mannequin/core/main.hpp"
 #include "mannequin/proto/schema.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
@@ -21,7 +23,7 @@ int main(int argc, char** argv) {
   CLI::App app{"mannequin-record: records the cluster's topics into an MCAP file (protobuf schemas, zstd\n"
                "chunks, index and summary). Stops on Ctrl-C/SIGTERM or after --duration; a killed recorder\n"
                "loses at most the last --flush-interval of messages."};
-  std::string deployment, run_dir, out, topics_arg, compression = "zstd", log_level = "info";
+  std::string deployment, run_dir, out, topics_arg, compression = "zstd", log_level = "info", client_key;
   std::vector<std::string> connect;
   double duration = 0, flush_interval = 1.0, progress = 5.0;
   std::uint64_t chunk_size = 1 << 20;
@@ -34,6 +36,10 @@ int main(int argc, char** argv) {
   app.add_option("--duration", duration, "stop after this many seconds (0 = until Ctrl-C)")
       ->check(CLI::NonNegativeNumber)->capture_default_str();
   app.add_option("--connect", connect, "publisher endpoint to connect to (repeatable; instead of or besides the deployment file)");
+  app.add_option("--client-key", client_key,
+                 "deployment with security (CURVE): this recorder's secret key file, a key the deployment admits "
+                 "(security.clients: KEY_DIR/NAME.key_secret)")
+      ->check(CLI::ExistingFile);
   app.add_option("--compression", compression, "chunk compression")->check(CLI::IsMember({"zstd", "none"}))->capture_default_str();
   app.add_option("--zstd-level", zstd_level, "zstd level")->check(CLI::Range(1, 19))->capture_default_str();
   app.add_option("--chunk-size", chunk_size, "bytes of messages per chunk before it is written")
@@ -49,9 +55,15 @@ int main(int argc, char** argv) {
     spdlog::set_pattern("[%H:%M:%S.%e] [record] %^%l%$ %v");
     const auto& stop = core::installStopSignals();
     std::vector<std::string> endpoints = connect;
+    std::optional<transport::CurveClientOptions> curve;
     if (!deployment.empty()) {
       for (const std::string& e : tools::publishEndpoints(deployment, run_dir)) endpoints.push_back(e);
+      const deploy::Deployment d = deploy::loadDeployment(deployment, run_dir);
+      if (d.security && client_key.empty())
+        throw CLI::ValidationError(deployment + " uses CURVE (security): give --client-key NAME.key_secret of one of its clients");
+      if (d.security) curve = d.clientKeys(client_key);  // each service's public key by its address
     }
+    if (!client_key.empty() && !curve) throw CLI::ValidationError("--client-key needs a deployment file with security");
     const std::vector<std::string> wanted = tools::splitList(topics_arg);
     const std::set<std::string> wanted_set(wanted.begin(), wanted.end());
     for (const std::string& t : wanted) {
@@ -68,7 +80,7 @@ int main(int argc, char** argv) {
     recording::McapWriter writer(out, wo);
 
     zmq::context_t context;
-    transport::Subscriber sub(context, {"record", endpoints});
+    transport::Subscriber sub(context, {"record", endpoints, 1000, 10000, curve});
     std::map<std::string, std::uint16_t, std::less<>> channels;
     std::map<std::string, std::uint16_t> schemas;
     std::uint64_t bytes = 0, unparsed = 0;

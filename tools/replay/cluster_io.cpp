@@ -13,16 +13,16 @@
 namespace mannequin::tools {
 
 std::vector<std::string> publishEndpoints(const std::string& deployment_file, const std::string& run_dir,
-                                          const std::vector<std::string>& names) {
+                                          const std::vector<std::string>& names, bool bind) {
   const deploy::Deployment d = deploy::loadDeployment(deployment_file, run_dir);
   std::vector<std::string> out;
   if (names.empty()) {
-    for (const deploy::ServiceSpec& s : d.services) out.push_back(s.publish);
+    for (const deploy::ServiceSpec& s : d.services) out.push_back(bind ? s.publish : s.address);
     return out;
   }
   for (const std::string& n : names) {
     try {
-      out.push_back(d.endpointOf(n));
+      out.push_back(bind ? d.endpointOf(n) : d.addressOf(n));
     } catch (const std::out_of_range&) {
       std::string all;
       for (const deploy::ServiceSpec& s : d.services) all += (all.empty() ? "" : ", ") + s.name;

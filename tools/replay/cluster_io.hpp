@@ -10,12 +10,14 @@
 
 namespace mannequin::tools {
 
-/// Publish endpoints of the deployment file's services (deploy::loadDeployment, ${RUN_DIR}
-/// expanded with run_dir, "" = the file's default): `names` empty = every service, else the named
-/// ones. \throws core::ConfigError "FILE:LINE: ..." for a bad file, std::runtime_error naming
+/// Endpoints of the deployment file's services (deploy::loadDeployment, ${RUN_DIR} expanded with
+/// run_dir, "" = the file's default): `names` empty = every service, else the named ones; `bind`: the
+/// endpoints they bind (to stand in for them), else the addresses others connect to (the same on a
+/// single host; multi-host: tcp://HOST_ADDRESS:PORT for a service binding tcp://*:PORT).
+/// \throws core::ConfigError "FILE:LINE: ..." for a bad file, std::runtime_error naming
 /// an unknown service (with the deployment's services).
 std::vector<std::string> publishEndpoints(const std::string& deployment_file, const std::string& run_dir,
-                                          const std::vector<std::string>& names = {});
+                                          const std::vector<std::string>& names = {}, bool bind = false);
 
 /// Header fields of a raw mannequin.v1 payload (field 1 of every top-level message).
 struct RawHeader {

@@ -130,7 +130,7 @@ int main(int argc, char** argv) {
     recording::Player player(reader, po);  // validates topics and rate
 
     if (!as_services.empty()) {
-      for (const std::string& e : tools::publishEndpoints(deployment, run_dir, tools::splitList(as_services))) publish.push_back(e);
+      for (const std::string& e : tools::publishEndpoints(deployment, run_dir, tools::splitList(as_services), true)) publish.push_back(e);
     }
     if (!ack_from.empty()) {
       for (const std::string& e : tools::publishEndpoints(deployment, run_dir, {ack_from})) ack_connect.push_back(e);

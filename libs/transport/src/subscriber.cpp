@@ -32,8 +32,11 @@ Subscriber::Subscriber(zmq::context_t& context, SubscriberOptions options)
     const std::string who = "subscriber '" + options_.name + "': CURVE ";
     if (!isZ85Key(c.public_key)) throw std::invalid_argument(who + "public key is not a Z85 key (40 characters)");
     if (!isZ85Key(c.secret_key)) throw std::invalid_argument(who + "secret key is not a Z85 key (40 characters)");
-    if (!isZ85Key(c.server_public_key)) throw std::invalid_argument(who + "server public key is not a Z85 key (40 characters)");
-    socket_.set(zmq::sockopt::curve_serverkey, c.server_public_key);
+    if (!c.server_public_key.empty() && !isZ85Key(c.server_public_key))
+      throw std::invalid_argument(who + "server public key is not a Z85 key (40 characters)");
+    for (const auto& [endpoint, key] : c.server_keys)
+      if (!isZ85Key(key)) throw std::invalid_argument(who + "server public key of '" + endpoint + "' is not a Z85 key (40 characters)");
+    if (!c.server_public_key.empty()) socket_.set(zmq::sockopt::curve_serverkey, c.server_public_key);
     socket_.set(zmq::sockopt::curve_publickey, c.public_key);
     socket_.set(zmq::sockopt::curve_secretkey, c.secret_key);
   }
@@ -43,6 +46,14 @@ Subscriber::Subscriber(zmq::context_t& context, SubscriberOptions options)
 
 void Subscriber::connect(const std::string& endpoint) {
   std::string ep = endpoint;
+  if (options_.curve) {
+    // the server key is taken per connection (libzmq copies the options into each session at connect)
+    const CurveClientOptions& c = *options_.curve;
+    const auto key = c.server_keys.find(endpoint);
+    if (key == c.server_keys.end() && c.server_public_key.empty())
+      throw std::invalid_argument("subscriber '" + options_.name + "': CURVE: no server public key for '" + endpoint + "'");
+    socket_.set(zmq::sockopt::curve_serverkey, key != c.server_keys.end() ? key->second : c.server_public_key);
+  }
   try {
     socket_.connect(ep);
   } catch (const zmq::error_t& e) {

@@ -15,7 +15,7 @@
 namespace mannequin::collisionservice {
 
 CollisionServiceConfig parseCollisionConfig(const core::ConfigNode& config) {
-  config.allowOnly({"name", "publish", "connect", "scene", "activation_distance", "mannequins"});
+  config.allowOnly({"name", "publish", "connect", "security", "scene", "activation_distance", "mannequins"});
   CollisionServiceConfig c;
   c.activation_distance = config.getIn("activation_distance", c.activation_distance, 0.0, 10.0);
   if (auto scene = config.find("scene")) {
@@ -145,7 +145,7 @@ struct CollisionService::Impl {
   double worst_ms = 0;
 
   Impl(const CollisionServiceConfig& c, const service::Endpoints& e, zmq::context_t& ctx, double hb)
-      : endpoints(e), handler(c), pub(ctx, {e.name, e.publish}), sub(ctx, {e.name, e.connect}), health(pub, e.name, &sub, hb) {
+      : endpoints(e), handler(c), pub(ctx, service::publisherOptions(e)), sub(ctx, service::subscriberOptions(e)), health(pub, e.name, &sub, hb) {
     sub.subscribe(transport::topics::kCollisionQuery,
                   std::function<void(const v1::CollisionQuery&)>([this](const v1::CollisionQuery& q) { onQuery(q); }),
                   transport::validateCollisionQuery);

@@ -16,6 +16,10 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
       ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   app.add_option("--log-level", o.log_level, "trace, debug, info, warn, error")->capture_default_str()->check(core::logLevelCheck());
+  app.add_option("--security", o.security,
+                 "YAML file whose 'security' section (CURVE keys) replaces the config's; mannequin-launch writes one per "
+                 "service of a deployment with security")
+      ->check(CLI::ExistingFile);
   app.add_option("--heartbeat-period", o.heartbeat_period, "seconds between heartbeats")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 60.0));
@@ -46,7 +50,11 @@ Endpoints resolveEndpoints(const CommonOptions& o, const core::ConfigNode& confi
   if (e.publish.empty()) throw core::ConfigError(o.config + ": no publish endpoint (config 'publish' or --publish)");
   e.connect = o.connect;
   if (e.connect.empty() && config.has("connect")) e.connect = config["connect"].strings();
-  e.security = readSecurity(config, !e.connect.empty());
+  if (o.security.empty()) {
+    e.security = readSecurity(config, !e.connect.empty());
+  } else {
+    e.security = readSecurityFile(o.security, !e.connect.empty());
+  }
   return e;
 }
 
@@ -74,8 +82,9 @@ Security readSecurity(const core::ConfigNode& config, bool connects) {
   Security s;
   const auto section = config.find("security");
   if (!section) return s;
-  if (!section->isMap()) section->fail("expected a map (secret_key_file, public_key_file, server_public_key_file, authorized_keys)");
-  section->allowOnly({"secret_key_file", "public_key_file", "server_public_key_file", "authorized_keys"});
+  if (!section->isMap())
+    section->fail("expected a map (secret_key_file, public_key_file, server_public_key_file, servers, authorized_keys)");
+  section->allowOnly({"secret_key_file", "public_key_file", "server_public_key_file", "servers", "authorized_keys"});
   if (!transport::hasCurve()) section->fail("this libzmq has no CURVE support");
   const core::ConfigNode secret_node = (*section)["secret_key_file"];
   const std::string secret = keyFrom(secret_node, true);
@@ -93,12 +102,28 @@ Security readSecurity(const core::ConfigNode& config, bool connects) {
   }
   s.server = std::move(server);
 
-  if (const auto sp = section->find("server_public_key_file")) {
-    s.client = transport::CurveClientOptions{public_key, secret, keyFrom(*sp, false)};
-  } else if (connects) {
-    section->fail("missing key 'server_public_key_file' (the service connects to publishers)");
+  transport::CurveClientOptions client{public_key, secret, {}};
+  if (const auto sp = section->find("server_public_key_file")) client.server_public_key = keyFrom(*sp, false);
+  if (const auto servers = section->find("servers")) {
+    for (const core::ConfigNode& server : servers->items()) {
+      server.allowOnly({"connect", "public_key_file"});
+      const std::string endpoint = server["connect"].str();
+      if (!client.server_keys.emplace(endpoint, keyFrom(server["public_key_file"], false)).second)
+        server["connect"].fail("'" + endpoint + "' listed twice");
+    }
   }
+  if (!client.server_public_key.empty() || !client.server_keys.empty())
+    s.client = std::move(client);
+  else if (connects)
+    section->fail("missing key 'server_public_key_file' or 'servers' (the service connects to publishers)");
   return s;
+}
+
+Security readSecurityFile(const std::string& path, bool connects) {
+  const core::ConfigNode file = core::ConfigNode::load(path);
+  file.allowOnly({"security"});
+  if (!file.has("security")) file.fail("no 'security' section");
+  return readSecurity(file, connects);
 }
 
 transport::PublisherOptions publisherOptions(const Endpoints& e) {

@@ -135,7 +135,7 @@ void parsePhysics(const ConfigNode& ph, sim::PhysicsConfig& p) {
 }
 
 SimServiceConfig parseSimConfig(const ConfigNode& root) {
-  root.allowOnly({"name", "publish", "connect", "mode", "step", "world_rate", "publish_on_mocap", "interpolation_delay",
+  root.allowOnly({"name", "publish", "connect", "security", "mode", "step", "world_rate", "publish_on_mocap", "interpolation_delay",
                   "reanchor_threshold", "occlusion", "calibration", "gains", "collision", "mannequins", "stepper",
                   "target_twist", "joint_limits", "physics", "mocap", "mocap_sources", "status_period", "scenario"});
   SimServiceConfig c;

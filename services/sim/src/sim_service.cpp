@@ -68,8 +68,9 @@ struct SimService::Impl {
   Impl(const SimServiceConfig& c, zmq::context_t& ctx, double hb)
       : config(c),
         world(buildMannequins(c), c.world),
-        pub(ctx, transport::PublisherOptions{c.name, c.publish, 1000, c.mode == Mode::kReplay}),
-        sub(ctx, transport::SubscriberOptions{c.name, subscriberEndpoints(c), c.mode == Mode::kReplay ? 100000 : 1000, 10000}),
+        pub(ctx, transport::PublisherOptions{c.name, c.publish, 1000, c.mode == Mode::kReplay, c.curve_server}),
+        sub(ctx, transport::SubscriberOptions{c.name, subscriberEndpoints(c), c.mode == Mode::kReplay ? 100000 : 1000, 10000,
+                                              c.curve_client}),
         health(pub, c.name, &sub, hb),
         schedule(config.scenario.triggers),
         watch(config.scenario.state_rate, config.world.step) {

@@ -5,6 +5,7 @@
 /// or late (liveness() is pure: unit-testable).
 #include <cstdint>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -22,8 +23,10 @@ ServiceState liveness(bool has_heartbeat, std::int64_t last_heartbeat_ns, std::i
 
 class HeartbeatMonitor {
  public:
-  /// Connects to every endpoint (a service's publish endpoint).
-  HeartbeatMonitor(zmq::context_t& context, const std::vector<std::string>& endpoints);
+  /// Connects to every endpoint (the address of a service), as a CURVE client when `curve` is set
+  /// (Deployment::clientKeys: the launcher's key pair, every service's public key by its address).
+  HeartbeatMonitor(zmq::context_t& context, const std::vector<std::string>& endpoints,
+                   std::optional<transport::CurveClientOptions> curve = std::nullopt);
   /// Receives what arrived (non-blocking) into the statuses of the services it names (by service name
   /// or message source): has_heartbeat, last_heartbeat_ns, heartbeat, heartbeats.
   void poll(std::vector<ServiceStatus>& status);

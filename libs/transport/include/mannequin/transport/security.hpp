@@ -12,8 +12,11 @@
 ///   so publishers of one context can list different keys. A refused key is logged (Z85 and peer
 ///   address, rate-limited per key and address) and counted (Publisher::curveRefusals()).
 /// - A subscriber with SubscriberOptions::curve is a CURVE client: its key pair and the server's
-///   public key. A server with another key never completes the handshake: nothing is received.
+///   public key, one for all its publishers or one per endpoint (CurveClientOptions::server_keys:
+///   each publisher of a deployment has its own key pair). A server with another key never completes
+///   the handshake: nothing is received.
 #include <cstdint>
+#include <map>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -30,7 +33,10 @@ struct CurveServerOptions {
 struct CurveClientOptions {
   std::string public_key;         ///< the client's public key (listed by the publishers)
   std::string secret_key;         ///< the client's secret key
-  std::string server_public_key;  ///< the publishers' public key
+  std::string server_public_key;  ///< the publishers' public key ("": every endpoint must be in server_keys)
+  /// Per publisher: its connect endpoint (as given to the subscriber) → its public key; an endpoint not
+  /// listed uses server_public_key.
+  std::map<std::string, std::string> server_keys = {};
 };
 
 struct CurveKeyPair {

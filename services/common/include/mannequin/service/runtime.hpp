@@ -29,6 +29,7 @@ struct CommonOptions {
   double duration = 0.0;              ///< --duration S: stop by itself after S seconds (0 = run until a signal)
   std::string log_level = "info";     ///< --log-level
   double heartbeat_period = 0.5;      ///< --heartbeat-period S
+  std::string security;               ///< --security FILE: its `security` section replaces the config's
 };
 
 /// Adds the common options to a CLI11 app (--config is required).
@@ -52,9 +53,12 @@ core::ConfigNode loadConfig(const CommonOptions& options, const std::function<vo
 ///   security:
 ///     secret_key_file: keys/sim.key_secret        # required; mode 0600
 ///     public_key_file: keys/sim.key               # optional; must be the secret's public key
-///     server_public_key_file: keys/cluster.key    # the publishers' key (required with `connect`)
+///     server_public_key_file: keys/cluster.key    # the publishers' key, for every endpoint not in servers
+///     servers:                                    # per publisher connected to: its key
+///       - {connect: tcp://10.0.0.10:5601, public_key_file: keys/mocap.key}
 ///     authorized_keys: [keys/render1.key, "Z85..."]  # clients admitted by this service's publisher
-/// Relative paths are relative to the config file's directory. No section: plaintext, as before.
+/// With `connect`, server_public_key_file or servers is required. Relative paths are relative to the
+/// config file's directory. No section: plaintext, as before.
 struct Security {
   std::optional<transport::CurveServerOptions> server;  ///< for the service's publisher
   std::optional<transport::CurveClientOptions> client;  ///< for the service's subscriber
@@ -64,9 +68,12 @@ struct Security {
 /// \throws core::ConfigError "FILE:LINE: field 'security.x': ..." naming the config entry of a bad,
 /// missing or world-readable key file or a bad key.
 Security readSecurity(const core::ConfigNode& config, bool connects);
+/// The `security` section of a file holding only that (--security FILE; mannequin-launch writes one per
+/// service of a deployment with security). \throws core::ConfigError "FILE:LINE: ...".
+Security readSecurityFile(const std::string& path, bool connects);
 
 /// Who a service is on the network: the command line wins over the config (`name`, `publish`, `connect`);
-/// its CURVE keys come from the config's `security` section.
+/// its CURVE keys come from the `security` section of --security FILE if given, else of the config.
 struct Endpoints {
   std::string name;
   std::vector<std::string> publish;

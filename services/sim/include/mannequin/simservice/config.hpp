@@ -1,9 +1,11 @@
 #pragma once
 /// \file config.hpp
 /// \brief The sim service's YAML config (configs/sim/sim_*.yaml; reference in docs/cluster.md).
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "mannequin/transport/security.hpp"
 #include "mannequin/core/config.hpp"
 #include "mannequin/scenario/scenario.hpp"
 #include "mannequin/sim/world.hpp"
@@ -69,6 +71,9 @@ enum class StepperKind { kController, kKinematic };
 struct SimServiceConfig {
   std::string name = "sim";
   std::vector<std::string> publish, connect;
+  /// CURVE keys of its publisher and subscriber (service::Endpoints::security; unset: plaintext)
+  std::optional<transport::CurveServerOptions> curve_server;
+  std::optional<transport::CurveClientOptions> curve_client;
   Mode mode = Mode::kLive;
   double world_rate = 60.0;   ///< sim.world per second of simulation time (≤ 1/step)
   bool publish_on_mocap = false;  ///< also publish sim.world at the first step after each new mocap frame
