@@ -85,6 +85,26 @@ TEST_F(SecurityConfig, KeysAreReadBesideTheConfig) {
   EXPECT_EQ(s.curve->server_public_key, pairs["mocap"].public_key);
 }
 
+// A path of 40 characters is also 40 characters of the Z85 alphabet ('/', '.', '-', letters, digits): an entry
+// naming a file that exists is that key file, not a key written inline (CI found it: the launcher's run
+// directory /tmp/mq-e2e-hosts-4169/keys/launch.a.key made a client's key file look like a key).
+TEST_F(SecurityConfig, AnAuthorizedKeyFileWhosePathLooksLikeAZ85KeyIsReadAsAFile) {
+  const std::string rel = "keys/a-path-of-forty-characters-long.key";
+  ASSERT_EQ(rel.size(), 40u);
+  ASSERT_TRUE(isZ85Key(rel));
+  writeKeyFile((dir.path() / rel).string(), pairs["render1"].public_key, "public", 0644);
+  const service::Endpoints e = resolve(
+      "publish: tcp://127.0.0.1:0\nsecurity:\n  secret_key_file: keys/sim.key_secret\n  authorized_keys: [" + rel + "]\n");
+  const PublisherOptions p = service::publisherOptions(e);
+  ASSERT_TRUE(p.curve.has_value());
+  EXPECT_EQ(p.curve->authorized_keys, (std::vector<std::string>{pairs["render1"].public_key}));
+  // without the file, the same 40 characters are taken as a key written inline
+  std::filesystem::remove(dir.path() / rel);
+  EXPECT_EQ(service::publisherOptions(resolve("publish: tcp://127.0.0.1:0\nsecurity:\n  secret_key_file: keys/sim.key_secret\n"
+                                              "  authorized_keys: [" + rel + "]\n")).curve->authorized_keys,
+            (std::vector<std::string>{rel}));
+}
+
 TEST_F(SecurityConfig, BadEntriesNameFileAndLine) {
   const std::string ok = pairs["mocap"].public_key;
   std::string y = good(ok);

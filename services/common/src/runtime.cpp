@@ -97,8 +97,12 @@ Security readSecurity(const core::ConfigNode& config, bool connects) {
   const core::ConfigNode listed = (*section)["authorized_keys"];
   const std::vector<core::ConfigNode> entries = listed.isSequence() ? listed.items() : std::vector<core::ConfigNode>{listed};
   for (const core::ConfigNode& entry : entries) {
+    // a key file if one exists there (a path can be 40 characters of the Z85 alphabet too, e.g.
+    // /tmp/mq-e2e-hosts-4169/keys/launch.a.key), else a Z85 key written inline, else a missing key file
     const std::string text = entry.str();
-    server.authorized_keys.push_back(transport::isZ85Key(text) ? text : keyFrom(entry, false));
+    std::error_code ec;
+    const bool is_file = !text.empty() && std::filesystem::is_regular_file(besideConfig(entry), ec);
+    server.authorized_keys.push_back(!is_file && transport::isZ85Key(text) ? text : keyFrom(entry, false));
   }
   s.server = std::move(server);
 

@@ -56,7 +56,8 @@ core::ConfigNode loadConfig(const CommonOptions& options, const std::function<vo
 ///     server_public_key_file: keys/cluster.key    # the publishers' key, for every endpoint not in servers
 ///     servers:                                    # per publisher connected to: its key
 ///       - {connect: tcp://10.0.0.10:5601, public_key_file: keys/mocap.key}
-///     authorized_keys: [keys/render1.key, "Z85..."]  # clients admitted by this service's publisher
+///     authorized_keys: [keys/render1.key, "Z85..."]  # clients admitted by this service's publisher: a key
+///                                                    # file where one exists, else a 40-character Z85 key
 /// With `connect`, server_public_key_file or servers is required. Relative paths are relative to the
 /// config file's directory. No section: plaintext, as before.
 struct Security {
