@@ -11,12 +11,16 @@ int main(int argc, char** argv) {
   service::CommonOptions& common = cli.options;
   std::string mode;
   double world_rate = 0;
+  std::string scenario;
   cli.app.add_option("--mode", mode, "override the config's mode (live, replay)")->check(CLI::IsMember({"live", "replay"}));
   cli.app.add_option("--world-rate", world_rate, "override world_rate (Hz)")->check(CLI::PositiveNumber);
+  cli.app.add_option("--scenario", scenario, "run this scenario (configs/scenarios/*.yaml), replacing the config's `scenario`")
+      ->check(CLI::ExistingFile);
   return cli.run(argc, argv, [&](const std::atomic<bool>& stop) {
     const core::ConfigNode node = service::loadConfig(common, [&](YAML::Node& raw) {
       if (!mode.empty()) raw["mode"] = mode;
       if (world_rate > 0) raw["world_rate"] = world_rate;
+      if (!scenario.empty()) raw["scenario"] = scenario;
     });
     simservice::SimServiceConfig config = simservice::parseSimConfig(node);
     const service::Endpoints ep = service::resolveEndpoints(common, node, "sim");

@@ -85,6 +85,22 @@ TEST(Deployment, ShippedDeploymentsParse) {
     EXPECT_GE(d.services.size(), 1u) << f;
     EXPECT_FALSE(d.multiHost()) << f;
   }
+  // the demonstrations live (docs/demos.md): mocap and sim (the jump with collision), a view
+  for (const char* demo : {"jump", "ball", "piano", "drill", "waiter", "pilot", "rotor"}) {
+    const std::string f = std::string("configs/deployments/demo-") + demo + ".yaml";
+    const Deployment d = loadDeployment(f);
+    EXPECT_FALSE(d.multiHost()) << f;
+    bool has_sim = false;
+    for (const ServiceSpec& s : d.services) {
+      has_sim = has_sim || s.exec == "mannequin-sim";
+      for (const std::string& a : s.args) {  // every file an argument names is shipped
+        if (a.rfind("configs/", 0) == 0) {
+          EXPECT_TRUE(std::filesystem::exists(a)) << f << ": " << s.name << ": " << a;
+        }
+      }
+    }
+    EXPECT_TRUE(has_sim) << f;
+  }
   // the VR room: one mocap host, one sim host (sim + collision), four render hosts (a wall each)
   const Deployment room = loadDeployment("configs/deployments/vr-room.yaml");
   ASSERT_TRUE(room.multiHost());

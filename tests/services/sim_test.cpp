@@ -692,3 +692,26 @@ TEST(TriggerTool, SendsOnceToASubscriberAndRefusesBadTriggers) {
   EXPECT_EQ(bad.exit_code, 2) << bad.err;
   EXPECT_NE(bad.err.find("at most 128"), std::string::npos) << bad.err;
 }
+
+// mannequin-sim --scenario replaces the config's `scenario` (the jump's deployment runs the shipped demo config
+// with configs/scenarios/jump.yaml so): the ball scenario on the ball config starts; the same option naming the
+// jump scenario (mannequin 'operator') on the ball config (mannequin 'player') is refused naming both (a bad
+// config: exit 1, docs/cluster.md) — the scenario the World got is the option's, not the config's; a missing
+// file is a bad command line (exit 2).
+TEST(SimTool, ScenarioOptionReplacesTheConfigsScenario) {
+  namespace fs = std::filesystem;
+  const fs::path tool = testutil::binDir() / "mannequin-sim";
+  ASSERT_TRUE(fs::exists(tool)) << tool;
+  const std::string dir = tempDir();
+  const std::string common = tool.string() + " --config configs/sim/sim_ball.yaml --publish ipc://" + dir + "/sim --connect ipc://" + dir +
+                             "/mocap --duration 0.3";
+  const testutil::ToolResult same = testutil::runTool(common + " --scenario configs/scenarios/ball.yaml", 60);
+  EXPECT_EQ(same.exit_code, 0) << same.err;
+  const testutil::ToolResult other = testutil::runTool(common + " --scenario configs/scenarios/jump.yaml", 60);
+  EXPECT_EQ(other.exit_code, 1) << other.err;
+  EXPECT_NE(other.err.find("jump"), std::string::npos) << other.err;
+  EXPECT_NE(other.err.find("operator"), std::string::npos) << other.err;
+  const testutil::ToolResult missing = testutil::runTool(common + " --scenario configs/scenarios/nonexistent.yaml", 60);
+  EXPECT_EQ(missing.exit_code, 2) << missing.err;
+  EXPECT_NE(missing.err.find("nonexistent.yaml"), std::string::npos) << missing.err;
+}
