@@ -348,7 +348,8 @@ TEST(EndToEnd, ASimKilledWithSigkillResumesWhereItWasFromItsCheckpoint) {
   const std::string checkpoint = run + "/sim.checkpoint";
   const std::string log = (dir / "launch.log").string();
   const pid_t launcher = testutil::spawnProcess({std::string(MANNEQUIN_BIN_DIR) + "/mannequin-launch", (dir / "deploy.yaml").string(),
-                                                "--run-dir", run, "--status-period", "1"},
+                                                "--run-dir", run, "--status-period", "0.2", "--status-json",
+                                                (dir / "status.json").string()},
                                                log);
   ASSERT_GT(launcher, 0);
   zmq::context_t ctx;
@@ -379,6 +380,10 @@ TEST(EndToEnd, ASimKilledWithSigkillResumesWhereItWasFromItsCheckpoint) {
     }
     settled = std::chrono::steady_clock::now() - frame_since > std::chrono::milliseconds(500) && std::filesystem::exists(checkpoint);
   }
+  // the live status file (--status-json) names the sim, up, with its heartbeat statistics
+  const std::string status = readFile((dir / "status.json").string());
+  EXPECT_NE(status.find("{\"name\": \"sim\", \"state\": \"up\""), std::string::npos) << status;
+  EXPECT_NE(status.find("\"dropped_steps\": "), std::string::npos) << status;
   const v1::WorldState before = worlds.back();
   const double x = before.mannequins(0).q(0), y = before.mannequins(0).q(1), z = before.mannequins(0).q(2);
   ASSERT_GT(std::hypot(x, y), 1.5) << "the mannequin should stand under the actor, 2.2 m from the origin";

@@ -328,6 +328,7 @@ struct SimService::Impl {
     health.setStat("mocap_frames", static_cast<double>(stats.mocap_frames));
     if (config.collision.mode == CollisionMode::kService) health.setStat("stale_contacts", static_cast<double>(stats.stale_contacts));
     health.setStat("overruns", static_cast<double>(stats.overruns));
+    health.setStat("dropped_steps", static_cast<double>(stats.dropped_steps));
     double worst_pos = 0;
     int calibrated = 0;
     for (int i = 0; i < world.numMannequins(); ++i) {
@@ -395,6 +396,7 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
               next += s.step_ns;
               if (late > 10'000'000) {  // more than 10 ms behind: resynchronise instead of running a burst of steps
                 ++s.stats.overruns;
+                s.stats.dropped_steps += static_cast<std::uint64_t>(late / s.step_ns);
                 next = transport::steadyNs() + s.step_ns;
               }
             }
