@@ -2,10 +2,13 @@
 #include <spdlog/spdlog.h>
 #include <unistd.h>
 
+#include <atomic>
+#include <chrono>
 #include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <optional>
+#include <thread>
 
 #include "mannequin/core/config.hpp"
 #include "mannequin/core/main.hpp"
@@ -18,7 +21,7 @@ int main(int argc, char** argv) {
                "--host), prefixes their output, shows a status line from the heartbeats of every service of the\n"
                "deployment (services up, rates, lateness), restarts a crashed service with backoff, and stops all\n"
                "cleanly on Ctrl-C / SIGTERM / --duration. A bad deployment file is FILE:LINE and exit 2."};
-  std::string file, run_dir, summary_json, host, key_dir;
+  std::string file, run_dir, summary_json, status_json, host, key_dir;
   double duration = 0, status_period = 5.0;
   bool check = false, no_tty = false;
   app.add_option("deployment", file, "deployment file (YAML), e.g. configs/deployments/single-host.yaml")
@@ -35,6 +38,9 @@ int main(int argc, char** argv) {
       ->check(CLI::NonNegativeNumber);
   app.add_flag("--no-tty", no_tty, "print status lines instead of one live line even on a terminal");
   app.add_option("--summary-json", summary_json, "also write the final summary as JSON to this file");
+  app.add_option("--status-json", status_json,
+                 "keep the live status in this file, the --summary-json format, rewritten (FILE.tmp renamed) every "
+                 "status period (1 s if 0): for monitoring tools (tools/soak)");
   app.add_flag("--check", check,
                "read and check the deployment, print the command lines (multi-host without --host: every host's), "
                "start nothing");
@@ -88,7 +94,34 @@ int main(int argc, char** argv) {
     o.host = host;
     deploy::Supervisor supervisor(d, o);
     const auto& stop = core::installStopSignals();
+    // --status-json: the snapshot (Supervisor::status is thread-safe) written from its own thread
+    std::atomic<bool> run_done{false};
+    std::thread status_writer;
+    if (!status_json.empty())
+      status_writer = std::thread([&] {
+        const auto period = std::chrono::duration<double>(status_period > 0 ? status_period : 1.0);
+        auto next = std::chrono::steady_clock::now();
+        bool warned = false;
+        while (!run_done.load()) {
+          if (std::chrono::steady_clock::now() >= next) {
+            next += std::chrono::duration_cast<std::chrono::steady_clock::duration>(period);
+            const std::string tmp = status_json + ".tmp";
+            std::ofstream out(tmp, std::ios::trunc);
+            out << supervisor.summaryJson();
+            out.close();
+            std::error_code ec;
+            if (out) std::filesystem::rename(tmp, status_json, ec);
+            if ((!out || ec) && !warned) {
+              warned = true;
+              std::cerr << "mannequin-launch: --status-json " << status_json << ": cannot write\n";
+            }
+          }
+          std::this_thread::sleep_for(std::chrono::milliseconds(50));
+        }
+      });
     const int rc = supervisor.run(stop);
+    run_done = true;
+    if (status_writer.joinable()) status_writer.join();
     std::cout << supervisor.summary() << std::flush;
     if (!summary_json.empty()) {
       std::ofstream out(summary_json);

@@ -5,13 +5,25 @@
 //   each in its own thread: messages/s delivered to every subscriber;
 // - MocapToWorld: a live sim service in-process (1 ms step, sim.world published at the first step after
 //   each new mocap frame), 10 000 MocapFrames at 1 kHz: latency from a frame's publication to the
-//   reception of the first WorldState computed from it (p50, p99, max, in µs).
+//   reception of the first WorldState computed from it (p50, p99, max, in µs);
+// - VethThroughput8/curve:0|1 and VethLatency8/curve:0|1: sim.world over tcp across a veth pair, the
+//   publisher in one network namespace and 8 subscribers in another (made by the benchmark with `ip`,
+//   deleted after; needs root: skipped with the reason otherwise), plaintext and CURVE: messages/s
+//   delivered to every subscriber, and the one-way latency (p50, p99, max) of real WorldStates published
+//   at 1 kHz, from the publisher's send time to each subscriber's reception (one clock: same host).
 #include <benchmark/benchmark.h>
+#include <fcntl.h>
+#include <sched.h>
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <atomic>
+#include <cerrno>
+#include <cstring>
 #include <filesystem>
+#include <functional>
+#include <optional>
 #include <thread>
 
 #include "bench_main.hpp"
@@ -21,6 +33,7 @@
 #include "mannequin/transport/clock.hpp"
 #include "mannequin/transport/convert.hpp"
 #include "mannequin/transport/publisher.hpp"
+#include "mannequin/transport/security.hpp"
 #include "mannequin/transport/subscriber.hpp"
 
 using namespace mannequin;
@@ -198,6 +211,254 @@ void MocapToWorld(benchmark::State& state) {
   }
 }
 BENCHMARK(MocapToWorld)->Arg(10000)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+
+// ---- tcp over a veth pair between two network namespaces ----
+
+/// Two network namespaces joined by a veth pair (10.231.0.1/24 in `a`, 10.231.0.2/24 in `b`), made with
+/// `ip` for one benchmark and deleted by the destructor. error() says why not when it could not be made.
+class VethPair {
+ public:
+  VethPair() : a_("mqbench" + std::to_string(getpid()) + "a"), b_("mqbench" + std::to_string(getpid()) + "b") {
+    if (::geteuid() != 0) {
+      error_ = "needs root (CAP_SYS_ADMIN, CAP_NET_ADMIN) to make network namespaces and a veth pair";
+      return;
+    }
+    for (const char* p : {"/usr/sbin/ip", "/sbin/ip", "/usr/bin/ip", "/bin/ip"})
+      if (::access(p, X_OK) == 0) ip_ = p;
+    if (ip_.empty()) {
+      error_ = "no 'ip' tool (iproute2)";
+      return;
+    }
+    const std::vector<std::vector<std::string>> steps = {
+        {"netns", "add", a_},
+        {"netns", "add", b_},
+        {"link", "add", "veth0", "netns", a_, "type", "veth", "peer", "name", "veth0", "netns", b_},
+        {"-n", a_, "addr", "add", std::string(kAddressA) + "/24", "dev", "veth0"},
+        {"-n", b_, "addr", "add", std::string(kAddressB) + "/24", "dev", "veth0"},
+        {"-n", a_, "link", "set", "lo", "up"},
+        {"-n", b_, "link", "set", "lo", "up"},
+        {"-n", a_, "link", "set", "veth0", "up"},
+        {"-n", b_, "link", "set", "veth0", "up"},
+    };
+    for (const auto& args : steps) {
+      if (args[0] == "netns" && args[1] == "add") created_.push_back(args[2]);
+      if (!run(args)) {
+        std::string cmd = "ip";
+        for (const auto& x : args) cmd += " " + x;
+        error_ = cmd + " failed (no privilege for network namespaces here?)";
+        return;
+      }
+    }
+  }
+  ~VethPair() {
+    for (const std::string& ns : created_) run({"netns", "del", ns});
+  }
+  VethPair(const VethPair&) = delete;
+  VethPair& operator=(const VethPair&) = delete;
+  const std::string& error() const { return error_; }
+  const std::string& a() const { return a_; }
+  const std::string& b() const { return b_; }
+  static constexpr const char* kAddressA = "10.231.0.1";
+  static constexpr const char* kAddressB = "10.231.0.2";
+
+ private:
+  bool run(const std::vector<std::string>& args) const {
+    std::vector<char*> argv{const_cast<char*>(ip_.c_str())};
+    for (const std::string& x : args) argv.push_back(const_cast<char*>(x.c_str()));
+    argv.push_back(nullptr);
+    const pid_t pid = ::fork();
+    if (pid == 0) {
+      const int null = ::open("/dev/null", O_WRONLY);
+      if (null >= 0) {
+        ::dup2(null, STDOUT_FILENO);
+        ::dup2(null, STDERR_FILENO);
+      }
+      ::execv(argv[0], argv.data());
+      ::_exit(127);
+    }
+    if (pid <= 0) return false;
+    int status = 0;
+    if (::waitpid(pid, &status, 0) != pid) return false;
+    return WIFEXITED(status) && WEXITSTATUS(status) == 0;
+  }
+  std::string a_, b_, ip_, error_;
+  std::vector<std::string> created_;
+};
+
+/// The calling thread in network namespace `ns` (ip netns's /run/netns/NS) until destruction; sockets
+/// and the ZeroMQ I/O threads a context starts from this thread belong to that namespace.
+class InNetns {
+ public:
+  explicit InNetns(const std::string& ns)
+      : self_(::open("/proc/thread-self/ns/net", O_RDONLY | O_CLOEXEC)), target_(::open(("/run/netns/" + ns).c_str(), O_RDONLY | O_CLOEXEC)) {
+    if (self_ < 0 || target_ < 0 || ::setns(target_, CLONE_NEWNET) != 0)
+      throw std::runtime_error("cannot enter network namespace " + ns + ": " + std::strerror(errno));
+  }
+  ~InNetns() {
+    if (self_ >= 0 && ::setns(self_, CLONE_NEWNET) != 0) std::fprintf(stderr, "bench-transport: cannot leave a network namespace\n");
+    if (self_ >= 0) ::close(self_);
+    if (target_ >= 0) ::close(target_);
+  }
+  InNetns(const InNetns&) = delete;
+  InNetns& operator=(const InNetns&) = delete;
+
+ private:
+  int self_, target_;
+};
+
+/// The CURVE keys of one publisher and its subscribers (plaintext: none).
+struct VethKeys {
+  std::optional<transport::CurveServerOptions> server;
+  std::optional<transport::CurveClientOptions> client;
+  explicit VethKeys(bool curve) {
+    if (!curve) return;
+    const transport::CurveKeyPair s = transport::generateCurveKeyPair(), c = transport::generateCurveKeyPair();
+    server = transport::CurveServerOptions{s.secret_key, {c.public_key}};
+    transport::CurveClientOptions o;
+    o.public_key = c.public_key;
+    o.secret_key = c.secret_key;
+    o.server_public_key = s.public_key;
+    client = o;
+  }
+};
+
+/// 8 subscribers to sim.world in namespace `ns`, each in its own thread with its own context (its I/O
+/// thread in that namespace too); `on` is called in the subscriber's thread.
+class VethSubscribers {
+ public:
+  static constexpr int kCount = 8;
+  using Handler = std::function<void(int, std::string_view, const transport::Received&)>;
+  VethSubscribers(const std::string& ns, const std::string& endpoint, const std::optional<transport::CurveClientOptions>& curve, Handler on) {
+    for (int i = 0; i < kCount; ++i)
+      threads_.emplace_back([this, i, ns, endpoint, curve, on] {
+        try {
+          InNetns in(ns);
+          zmq::context_t ctx(1);
+          transport::SubscriberOptions so{"sub" + std::to_string(i), {endpoint}, 100000, 10000, curve};
+          transport::Subscriber sub(ctx, so);
+          sub.subscribeRaw("sim.world", [&](std::string_view, std::string_view payload, const transport::Received& r) { on(i, payload, r); });
+          while (!done_.load()) sub.poll(std::chrono::milliseconds(1));
+        } catch (const std::exception& e) {
+          std::fprintf(stderr, "bench-transport: subscriber %d: %s\n", i, e.what());
+        }
+      });
+  }
+  ~VethSubscribers() {
+    done_ = true;
+    for (auto& t : threads_) t.join();
+  }
+  VethSubscribers(const VethSubscribers&) = delete;
+  VethSubscribers& operator=(const VethSubscribers&) = delete;
+
+ private:
+  std::atomic<bool> done_{false};
+  std::vector<std::thread> threads_;
+};
+
+void VethThroughput8(benchmark::State& state) {
+  const bool curve = state.range(0) == 1;
+  VethPair veth;
+  if (!veth.error().empty()) {
+    state.SkipWithError(("skipped: " + veth.error()).c_str());
+    for (auto _ : state) {
+    }
+    return;
+  }
+  const VethKeys keys(curve);
+  const std::string payload = worldPayload();
+  std::vector<std::atomic<std::uint64_t>> counts(VethSubscribers::kCount);
+  const std::string endpoint = "tcp://" + std::string(VethPair::kAddressA) + ":5700";
+  InNetns in(veth.a());  // the publisher (this thread, its context's I/O thread) in namespace a
+  {
+    zmq::context_t ctx(1);
+    transport::PublisherOptions po{"sim", {endpoint}};
+    po.send_hwm = 100000;
+    po.curve = keys.server;
+    transport::Publisher pub(ctx, po);
+    VethSubscribers subs(veth.b(), endpoint, keys.client,
+                         [&](int i, std::string_view, const transport::Received&) { ++counts[static_cast<std::size_t>(i)]; });
+    waitSubscribed(pub, VethSubscribers::kCount);
+    std::uint64_t sent = 0;
+    const std::int64_t t0 = transport::steadyNs();
+    for (auto _ : state) {
+      pub.publishRaw("sim.world", payload);
+      ++sent;
+    }
+    auto minCount = [&] {
+      std::uint64_t m = ~0ull;
+      for (auto& c : counts) m = std::min<std::uint64_t>(m, c.load());
+      return m;
+    };
+    while (minCount() < sent && (transport::steadyNs() - t0) < 20'000'000'000LL) {
+      pub.poll();
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    const double seconds = static_cast<double>(transport::steadyNs() - t0) * 1e-9;
+    state.counters["msg_per_s_per_subscriber"] = static_cast<double>(minCount()) / seconds;
+    state.counters["delivered_fraction"] = static_cast<double>(minCount()) / static_cast<double>(sent);
+    state.counters["payload_bytes"] = static_cast<double>(payload.size());
+  }
+  state.SetLabel(curve ? "veth tcp, CURVE" : "veth tcp, plaintext");
+}
+BENCHMARK(VethThroughput8)->ArgName("curve")->Arg(0)->Arg(1)->Iterations(20000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+void VethLatency8(benchmark::State& state) {
+  const bool curve = state.range(0) == 1;
+  const int messages = 2000;  // at 1 kHz
+  VethPair veth;
+  if (!veth.error().empty()) {
+    state.SkipWithError(("skipped: " + veth.error()).c_str());
+    for (auto _ : state) {
+    }
+    return;
+  }
+  const VethKeys keys(curve);
+  const std::string endpoint = "tcp://" + std::string(VethPair::kAddressA) + ":5701";
+  InNetns in(veth.a());
+  for (auto _ : state) {
+    std::vector<std::vector<double>> latency_us(VethSubscribers::kCount);
+    for (auto& l : latency_us) l.reserve(messages);
+    zmq::context_t ctx(1);
+    transport::PublisherOptions po{"sim", {endpoint}};
+    po.curve = keys.server;
+    transport::Publisher pub(ctx, po);
+    {
+      VethSubscribers subs(veth.b(), endpoint, keys.client, [&](int i, std::string_view payload, const transport::Received& r) {
+        v1::WorldState w;  // parsed as a render node would
+        if (w.ParseFromArray(payload.data(), static_cast<int>(payload.size())) && w.header().send_time_ns() > 0)
+          latency_us[static_cast<std::size_t>(i)].push_back(static_cast<double>(r.receive_time_ns - w.header().send_time_ns()) * 1e-3);
+      });
+      waitSubscribed(pub, VethSubscribers::kCount);
+      const simservice::SimServiceConfig cfg = simDemoConfig();
+      sim::World world(simservice::buildMannequins(cfg), cfg.world);
+      world.step();
+      v1::WorldState w;
+      simservice::toWorldState(world, nullptr, false, false, w);
+      const std::int64_t start = transport::steadyNs();
+      for (int k = 0; k < messages; ++k) {
+        const std::int64_t due = start + static_cast<std::int64_t>(k) * 1'000'000;
+        while (transport::steadyNs() < due) std::this_thread::sleep_for(std::chrono::microseconds(50));
+        w.set_step(static_cast<std::uint64_t>(k));
+        pub.publish(topics::kSimWorld, w);
+      }
+      const std::int64_t tail = transport::steadyNs();
+      while (transport::steadyNs() - tail < 300'000'000) {
+        pub.poll();
+        std::this_thread::sleep_for(std::chrono::milliseconds(5));
+      }
+    }
+    std::vector<double> all;
+    for (const auto& l : latency_us) all.insert(all.end(), l.begin(), l.end());
+    std::sort(all.begin(), all.end());
+    auto pct = [&](double p) { return all.empty() ? -1.0 : all[static_cast<std::size_t>(p * static_cast<double>(all.size() - 1))]; };
+    state.counters["received_fraction"] = static_cast<double>(all.size()) / (static_cast<double>(messages) * VethSubscribers::kCount);
+    state.counters["p50_us"] = pct(0.5);
+    state.counters["p99_us"] = pct(0.99);
+    state.counters["max_us"] = all.empty() ? -1.0 : all.back();
+  }
+  state.SetLabel(curve ? "veth tcp, CURVE, 1 kHz" : "veth tcp, plaintext, 1 kHz");
+}
+BENCHMARK(VethLatency8)->ArgName("curve")->Arg(0)->Arg(1)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

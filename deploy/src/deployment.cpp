@@ -69,7 +69,7 @@ bool Deployment::runsOn(std::size_t i, const std::string& host) const {
   return !multiHost() || services.at(i).host == host;
 }
 
-std::vector<std::string> Deployment::commandLine(std::size_t i) const {
+std::vector<std::string> Deployment::commandLine(std::size_t i, bool resume) const {
   const ServiceSpec& s = services.at(i);
   std::vector<std::string> argv{s.exec, "--name", s.name, "--publish", s.publish};
   for (const auto& c : s.connect) {
@@ -79,6 +79,14 @@ std::vector<std::string> Deployment::commandLine(std::size_t i) const {
   if (security) {
     argv.push_back("--security");
     argv.push_back(securityFile(i));
+  }
+  if (!s.checkpoint.empty()) {
+    argv.push_back("--checkpoint");
+    argv.push_back(s.checkpoint);
+    if (resume) {
+      argv.push_back("--resume");
+      argv.push_back(s.checkpoint);
+    }
   }
   argv.insert(argv.end(), s.args.begin(), s.args.end());
   return argv;
@@ -258,7 +266,7 @@ Deployment readDeployment(const ConfigNode& root, const std::string& run_dir) {
   std::map<std::string, std::string> bound;  // "host|tcp port" or "host|endpoint" → service
   const ConfigNode services = root["services"];
   for (const ConfigNode& s : services.items()) {
-    s.allowOnly({"name", "host", "exec", "args", "publish", "connect", "restart"});
+    s.allowOnly({"name", "host", "exec", "args", "publish", "connect", "restart", "checkpoint"});
     ServiceSpec spec;
     spec.line = s.line();
     spec.name = s["name"].str();
@@ -276,6 +284,10 @@ Deployment readDeployment(const ConfigNode& root, const std::string& run_dir) {
     spec.exec = s["exec"].str();
     if (auto a = s.find("args"))
       for (const std::string& x : a->strings()) spec.args.push_back(expandRunDir(x, d.run_dir));
+    if (auto c = s.find("checkpoint")) {
+      spec.checkpoint = expandRunDir(c->str(), d.run_dir);
+      if (spec.checkpoint.empty() || spec.checkpoint.back() == '/') c->fail("not a file path");
+    }
     const ConfigNode pub = s["publish"];
     spec.publish = expandRunDir(pub.str(), d.run_dir);
     try {

@@ -159,13 +159,30 @@ int Supervisor::run(const std::atomic<bool>& stop) {
     }
   }
 
+  // checkpoints (a service's `checkpoint`): one left by a previous run is not resumed from (a launch is
+  // a fresh start; only a restart resumes)
+  std::vector<std::string> checkpoints;  // removed at the end
+  for (std::size_t i = 0; i < deployment_.services.size(); ++i) {
+    const std::string& f = deployment_.services[i].checkpoint;
+    if (!status_[i].local || f.empty()) continue;
+    checkpoints.push_back(f);
+    if (std::filesystem::exists(f, ec)) {
+      std::filesystem::remove(f, ec);
+      out.launcher(fmt::format("{}: removed the checkpoint {} a previous run left (a launch starts fresh)", status_[i].name, f));
+    }
+  }
+
   std::vector<std::string> endpoints;  // every service's, this host's and the others' (the whole room)
   for (const auto& s : deployment_.services) endpoints.push_back(s.address);
   impl_->heartbeats = std::make_unique<HeartbeatMonitor>(impl_->context, endpoints, monitor_keys);
   ProcessBackend& backend = *impl_->backend;
 
   auto start = [&](std::size_t i) {
-    std::vector<std::string> argv = deployment_.commandLine(i);
+    // a restart resumes from the checkpoint its previous run left, if any
+    const std::string& checkpoint = deployment_.services[i].checkpoint;
+    std::error_code exists_ec;
+    const bool resume = status_[i].starts > 0 && !checkpoint.empty() && std::filesystem::exists(checkpoint, exists_ec);
+    std::vector<std::string> argv = deployment_.commandLine(i, resume);
     std::string cmd;
     for (const auto& a : argv) cmd += (cmd.empty() ? "" : " ") + a;
     argv[0] = resolveExec(argv[0]);
@@ -347,6 +364,10 @@ int Supervisor::run(const std::atomic<bool>& stop) {
   impl_->heartbeats->poll(status_);
   for (std::size_t i = 0; i < status_.size(); ++i) drain(i);
   for (const std::string& f : security_files) std::filesystem::remove(f, ec);
+  for (const std::string& f : checkpoints) {
+    std::filesystem::remove(f, ec);
+    std::filesystem::remove(f + ".tmp", ec);
+  }
   if (deployment_.security) std::filesystem::remove(std::filesystem::path(deployment_.run_dir) / "security", ec);
   std::filesystem::remove(deployment_.run_dir, ec);  // only if empty
   publishSnapshot();

@@ -12,8 +12,17 @@ int main(int argc, char** argv) {
   std::string mode;
   double world_rate = 0;
   std::string scenario;
+  std::string checkpoint, resume;
+  double checkpoint_period = 0.1;
   cli.app.add_option("--mode", mode, "override the config's mode (live, replay)")->check(CLI::IsMember({"live", "replay"}));
   cli.app.add_option("--world-rate", world_rate, "override world_rate (Hz)")->check(CLI::PositiveNumber);
+  cli.app.add_option("--checkpoint", checkpoint,
+                     "keep the last published world state in FILE (written to FILE.tmp, renamed) to resume from after a restart");
+  cli.app.add_option("--checkpoint-period", checkpoint_period, "s between two checkpoints at most (default 0.1)")
+      ->check(CLI::Range(0.001, 3600.0));
+  cli.app.add_option("--resume", resume,
+                     "start from the checkpoint FILE (mannequins' configurations and calibration, objects' poses, step); "
+                     "one that cannot be read or does not fit the config is refused (logged) and the sim starts fresh");
   cli.app.add_option("--scenario", scenario, "run this scenario (configs/scenarios/*.yaml), replacing the config's `scenario`")
       ->check(CLI::ExistingFile);
   return cli.run(argc, argv, [&](const std::atomic<bool>& stop) {
@@ -29,6 +38,9 @@ int main(int argc, char** argv) {
     config.connect = ep.connect;
     config.curve_server = ep.security.server;
     config.curve_client = ep.security.client;
+    config.checkpoint = checkpoint;
+    config.checkpoint_period = checkpoint_period;
+    config.resume = resume;
     zmq::context_t context;
     simservice::SimService service(config, context, common.heartbeat_period);
     return service.run(stop, common.duration);

@@ -40,6 +40,16 @@ services:
   EXPECT_EQ(d.services[0].restart.max_restarts, 2);
   EXPECT_EQ(d.services[1].restart.policy, RestartPolicy::kNever);
   EXPECT_EQ(d.services[1].restart.max_restarts, 2);  // inherited
+  // a checkpoint: --checkpoint FILE always, --resume FILE when asked (a restart); an empty one refused
+  const Deployment c = parseDeployment(
+      "name: x\nservices:\n  - {name: sim, exec: s, publish: 'ipc://${RUN_DIR}/s', checkpoint: '${RUN_DIR}/sim.checkpoint'}\n",
+      "x.yaml", "/r");
+  EXPECT_EQ(c.services[0].checkpoint, "/r/sim.checkpoint");
+  EXPECT_EQ(c.commandLine(0), (std::vector<std::string>{"s", "--name", "sim", "--publish", "ipc:///r/s", "--checkpoint", "/r/sim.checkpoint"}));
+  EXPECT_EQ(c.commandLine(0, true), (std::vector<std::string>{"s", "--name", "sim", "--publish", "ipc:///r/s", "--checkpoint",
+                                                              "/r/sim.checkpoint", "--resume", "/r/sim.checkpoint"}));
+  EXPECT_THROW(parseDeployment("name: x\nservices:\n  - {name: sim, exec: s, publish: 'ipc:///r/s', checkpoint: ''}\n", "x.yaml"),
+               mannequin::core::ConfigError);
   // the run dir can be given from outside
   EXPECT_EQ(parseDeployment("name: x\nservices:\n  - {name: a, exec: b, publish: 'ipc://${RUN_DIR}/a'}\n", "x.yaml", "/r")
                 .services[0].publish,

@@ -347,3 +347,111 @@ TEST(EndToEnd, TheBallDemonstrationDeploymentRunsItsScenarioLive) {
   }
   std::filesystem::remove_all(dir);
 }
+
+// A restarted sim resumes from its checkpoint: mocap (a scripted actor standing 2 m from the origin,
+// 1.5 s of capture, then no more frames) and sim under the launcher, the sim with a `checkpoint`. Once
+// the capture has ended and the mannequin stands where the actor was, SIGKILL to the sim: the launcher
+// restarts it with --resume, and its first sim.world (read like a render node would) has the mannequin
+// calibrated where it was, not at the initial pose (standing at the origin, uncalibrated) — nothing else
+// could put it there, the mocap is silent. The launcher removes the checkpoint when it stops.
+TEST(EndToEnd, ASimKilledWithSigkillResumesWhereItWasFromItsCheckpoint) {
+  const auto dir = std::filesystem::temp_directory_path() / ("mq-e2e-resume-" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  std::filesystem::create_directories(dir);
+  const std::string run = (dir / "run").string();
+  {
+    std::ofstream(dir / "mocap.yaml") << "name: mocap\nsource: synthetic\nsynthetic:\n  rate_hz: 120\n  duration: 1.5\n  bodies:\n"
+                                         "    - {name: pelvis, center: [2, 1, 0.95]}\n    - {name: head, center: [2, 1, 1.65]}\n"
+                                         "    - {name: hand_l, center: [2.3, 1.25, 1.0]}\n    - {name: hand_r, center: [2.3, 0.75, 1.0]}\n"
+                                         "    - {name: foot_l, center: [2, 1.1, 0.08]}\n    - {name: foot_r, center: [2, 0.9, 0.08]}\n";
+    // the demo's sim config (physics on), without the collision service
+    std::ifstream in("configs/sim/sim_demo.yaml");
+    std::ofstream out(dir / "sim.yaml");
+    for (std::string line; std::getline(in, line);) out << (line.rfind("collision:", 0) == 0 ? "collision: {mode: none}" : line) << "\n";
+    std::ofstream(dir / "deploy.yaml") << "name: resume\nheartbeat_timeout: 2.0\nrestart: {policy: on-failure, backoff_initial: 0.2}\n"
+                                          "services:\n"
+                                          "  - name: mocap\n    exec: mannequin-mocap\n    args: [--config, " << (dir / "mocap.yaml").string()
+                                       << ", --heartbeat-period, '0.2']\n    publish: ipc://${RUN_DIR}/mocap\n"
+                                          "  - name: sim\n    exec: mannequin-sim\n    args: [--config, " << (dir / "sim.yaml").string()
+                                       << ", --heartbeat-period, '0.2']\n    publish: ipc://${RUN_DIR}/sim\n    connect: [mocap]\n"
+                                          "    checkpoint: ${RUN_DIR}/sim.checkpoint\n";
+  }
+  const std::string checkpoint = run + "/sim.checkpoint";
+  const std::string log = (dir / "launch.log").string();
+  const pid_t launcher = testutil::spawnProcess({std::string(MANNEQUIN_BIN_DIR) + "/mannequin-launch", (dir / "deploy.yaml").string(),
+                                                "--run-dir", run, "--status-period", "0.2", "--status-json",
+                                                (dir / "status.json").string()},
+                                               log);
+  ASSERT_GT(launcher, 0);
+  zmq::context_t ctx;
+  transport::Subscriber watch(ctx, {"e2e", {"ipc://" + run + "/sim"}});
+  std::vector<v1::WorldState> worlds;
+  watch.subscribe(transport::topics::kSimWorld,
+                  std::function<void(const v1::WorldState&)>([&](const v1::WorldState& w) { worlds.push_back(w); }));
+  const auto stopLauncher = [&] {
+    if (core::signalProcess(launcher, SIGTERM) == core::SignalResult::kSent)
+      testutil::waitExit(launcher, "mannequin-launch after SIGTERM", std::chrono::seconds(20));
+  };
+  // phase 1: calibrated, the capture over (its last frame number unchanged for 0.5 s), a checkpoint written
+  auto deadline = std::chrono::steady_clock::now() + std::chrono::seconds(40);
+  std::uint64_t last_frame = 0;
+  auto frame_since = std::chrono::steady_clock::now();
+  bool settled = false;
+  while (!settled) {
+    if (std::chrono::steady_clock::now() >= deadline) {
+      stopLauncher();
+      FAIL() << "within 40 s, no calibrated sim.world after the capture's end with a checkpoint (" << worlds.size()
+             << " sim.world)\n" << readFile(log);
+    }
+    watch.poll(std::chrono::milliseconds(10));
+    if (worlds.empty() || !worlds.back().mannequins(0).calibrated()) continue;
+    if (worlds.back().mocap().frame_number() != last_frame) {
+      last_frame = worlds.back().mocap().frame_number();
+      frame_since = std::chrono::steady_clock::now();
+    }
+    settled = std::chrono::steady_clock::now() - frame_since > std::chrono::milliseconds(500) && std::filesystem::exists(checkpoint);
+  }
+  // the live status file (--status-json) names the sim, up, with its heartbeat statistics
+  const std::string status = readFile((dir / "status.json").string());
+  EXPECT_NE(status.find("{\"name\": \"sim\", \"state\": \"up\""), std::string::npos) << status;
+  EXPECT_NE(status.find("\"dropped_steps\": "), std::string::npos) << status;
+  const v1::WorldState before = worlds.back();
+  const double x = before.mannequins(0).q(0), y = before.mannequins(0).q(1), z = before.mannequins(0).q(2);
+  ASSERT_GT(std::hypot(x, y), 1.5) << "the mannequin should stand under the actor, 2.2 m from the origin";
+
+  // phase 2: SIGKILL to the sim (its pid from the launcher's "started sim (pid N)")
+  const std::string text = readFile(log);
+  const auto at = text.find("started sim (pid ");
+  ASSERT_NE(at, std::string::npos) << text;
+  const pid_t sim = static_cast<pid_t>(std::stol(text.substr(at + 17)));
+  ASSERT_GT(sim, 0);
+  ASSERT_EQ(core::signalProcess(sim, SIGKILL), core::SignalResult::kSent);
+  // phase 3: the restarted sim's first sim.world (sequence starts again at 1 in a new process)
+  const std::size_t seen = worlds.size();
+  deadline = std::chrono::steady_clock::now() + std::chrono::seconds(30);
+  const v1::WorldState* resumed = nullptr;
+  while (resumed == nullptr) {
+    if (std::chrono::steady_clock::now() >= deadline) {
+      stopLauncher();
+      FAIL() << "within 30 s of the SIGKILL, no sim.world from a restarted sim\n" << readFile(log);
+    }
+    watch.poll(std::chrono::milliseconds(10));
+    for (std::size_t i = seen; i < worlds.size() && resumed == nullptr; ++i)
+      if (worlds[i].header().sequence() < before.header().sequence()) resumed = &worlds[i];
+  }
+  const v1::MannequinState& m = resumed->mannequins(0);
+  EXPECT_TRUE(m.calibrated()) << "the restarted sim should have the calibration back";
+  EXPECT_LT(std::hypot(m.q(0) - x, m.q(1) - y), 0.02) << "resumed at (" << m.q(0) << ", " << m.q(1) << "), was at (" << x << ", " << y << ")";
+  EXPECT_NEAR(m.q(2), z, 0.02);
+  // the step count continues from the checkpoint, written at most every 0.1 s (100 steps) at a sim.world
+  // (every 17 steps): at most ~120 steps before the last state seen (a fresh sim starts at 0)
+  EXPECT_GT(resumed->step() + 200, before.step()) << "the step count continues from the checkpoint";
+  const std::string after = readFile(log);
+  EXPECT_NE(after.find("--resume " + checkpoint), std::string::npos) << after;
+  EXPECT_NE(after.find("resumed from " + checkpoint), std::string::npos) << after;
+  ASSERT_EQ(core::signalProcess(launcher, SIGTERM), core::SignalResult::kSent);
+  // exit 1: a service of the run exited otherwise than 0 (the SIGKILL), by the launcher's design
+  EXPECT_EQ(testutil::waitExit(launcher, "mannequin-launch after SIGTERM", std::chrono::seconds(20)), 1) << readFile(log);
+  EXPECT_FALSE(std::filesystem::exists(checkpoint)) << "the launcher removes the checkpoint when it stops";
+  std::filesystem::remove_all(dir);
+}

@@ -326,4 +326,10 @@ int TriggerSchedule::due(sim::World& world) {
   return n;
 }
 
+std::size_t TriggerSchedule::skipBefore(double time) {
+  std::size_t n = 0;
+  for (; next_ < triggers_->size() && (*triggers_)[next_].at < time; ++next_) ++n;
+  return n;
+}
+
 }  // namespace mannequin::simservice

@@ -8,6 +8,7 @@
 #include <deque>
 
 #include "mannequin/service/runtime.hpp"
+#include "mannequin/simservice/checkpoint.hpp"
 #include "mannequin/simservice/messages.hpp"
 #include "mannequin/transport/clock.hpp"
 #include "mannequin/transport/convert.hpp"
@@ -64,6 +65,11 @@ struct SimService::Impl {
   TriggerSchedule schedule;
   v1::ScenarioState scenario_msg;
   ScenarioWatch watch;
+  // the checkpoint (--checkpoint): written by its own thread, at most every checkpoint_period s
+  std::unique_ptr<CheckpointWriter> checkpoint_writer;
+  v1::SimCheckpoint checkpoint_msg;
+  std::int64_t last_checkpoint_ns = 0;
+  std::uint64_t checkpoint_failures_logged = 0;
 
   Impl(const SimServiceConfig& c, zmq::context_t& ctx, double hb)
       : config(c),
@@ -75,6 +81,8 @@ struct SimService::Impl {
         schedule(config.scenario.triggers),
         watch(config.scenario.state_rate, config.world.step) {
     setupScenario(world, config);
+    if (!config.resume.empty()) resume();
+    if (!config.checkpoint.empty()) checkpoint_writer = std::make_unique<CheckpointWriter>(config.checkpoint);
     world_sources = world.mocapSources();
     period.reset(world.numMannequins());
     run_totals.reset(world.numMannequins());
@@ -88,6 +96,44 @@ struct SimService::Impl {
       sub.subscribe(topics::kScenarioTrigger,
                     std::function<void(const v1::Trigger&)>([this](const v1::Trigger& t) { onTrigger(t); }),
                     transport::validateTrigger);
+  }
+
+  // --resume FILE: the World put back as the checkpoint has it; a checkpoint that cannot be read or does
+  // not fit this World is refused (logged) and the sim starts fresh.
+  void resume() {
+    try {
+      const v1::SimCheckpoint c = readCheckpoint(config.resume);
+      const std::vector<std::string> notes = restoreWorld(world, c);
+      const std::size_t skipped = schedule.skipBefore(world.time());
+      std::string where;
+      for (int m = 0; m < world.numMannequins(); ++m) {
+        const skeleton::VectorX& q = world.q(m);
+        where += fmt::format("{}{} at ({:.3f}, {:.3f}, {:.3f}){}", where.empty() ? "" : ", ", world.name(m), q(0), q(1), q(2),
+                             world.calibrated(m) ? " calibrated" : " not calibrated");
+      }
+      const double age = static_cast<double>(transport::wallNs() - c.written_ns()) * 1e-9;
+      spdlog::info("{}: resumed from {} (written {:.3f} s ago): step {}, t {:.3f} s, {}{}", config.name, config.resume, age,
+                   world.stepCount(), world.time(), where,
+                   world.numObjects() > 0 ? fmt::format(", {} object pose(s)", world.numObjects()) : std::string());
+      for (const std::string& n : notes) spdlog::warn("{}: resumed: {}", config.name, n);
+      if (skipped > 0) spdlog::warn("{}: resumed: {} timed trigger(s) before t {:.3f} s skipped", config.name, skipped, world.time());
+    } catch (const std::exception& e) {  // std::runtime_error (file), std::invalid_argument (mismatch)
+      spdlog::error("{}: checkpoint refused, starting fresh from the initial pose: {}", config.name, e.what());
+    }
+  }
+
+  void checkpoint() {
+    if (!checkpoint_writer) return;
+    const std::int64_t now = transport::steadyNs();
+    if (last_checkpoint_ns != 0 && now - last_checkpoint_ns < static_cast<std::int64_t>(config.checkpoint_period * 1e9)) return;
+    last_checkpoint_ns = now;
+    toCheckpoint(world, world_msg, transport::wallNs(), checkpoint_msg);
+    checkpoint_writer->submit(encodeCheckpoint(checkpoint_msg));
+    const std::uint64_t failed = checkpoint_writer->failed();
+    if (failed > checkpoint_failures_logged) {
+      checkpoint_failures_logged = failed;
+      spdlog::warn("{}: checkpoint not written ({} failure(s)): {}", config.name, failed, checkpoint_writer->lastError());
+    }
   }
 
   void onTrigger(const v1::Trigger& t) {
@@ -270,6 +316,7 @@ struct SimService::Impl {
       toWorldState(world, has_contacts ? &contacts : nullptr, stale, config.mode == Mode::kReplay, world_msg);
       pub.publish(topics::kSimWorld, world_msg);
       ++stats.worlds;
+      checkpoint();
       new_mocap = false;
     }
   }
@@ -281,6 +328,7 @@ struct SimService::Impl {
     health.setStat("mocap_frames", static_cast<double>(stats.mocap_frames));
     if (config.collision.mode == CollisionMode::kService) health.setStat("stale_contacts", static_cast<double>(stats.stale_contacts));
     health.setStat("overruns", static_cast<double>(stats.overruns));
+    health.setStat("dropped_steps", static_cast<double>(stats.dropped_steps));
     double worst_pos = 0;
     int calibrated = 0;
     for (int i = 0; i < world.numMannequins(); ++i) {
@@ -348,6 +396,7 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
               next += s.step_ns;
               if (late > 10'000'000) {  // more than 10 ms behind: resynchronise instead of running a burst of steps
                 ++s.stats.overruns;
+                s.stats.dropped_steps += static_cast<std::uint64_t>(late / s.step_ns);
                 next = transport::steadyNs() + s.step_ns;
               }
             }

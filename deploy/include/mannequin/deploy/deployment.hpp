@@ -60,6 +60,9 @@ struct ServiceSpec {
   std::string publish;               ///< endpoint it binds on its host (expanded)
   std::string address;               ///< endpoint the others (and the launchers' monitors) connect to
   std::vector<std::string> connect;  ///< names of the services it subscribes to
+  /// Key `checkpoint` (expanded; "" none): a file the service keeps its state in (mannequin-sim
+  /// --checkpoint); a restart resumes from it (--resume). Removed when the launcher starts and stops.
+  std::string checkpoint;
   RestartOptions restart;
   int line = 0;                      ///< line of its entry in the file
 };
@@ -86,8 +89,8 @@ struct Deployment {
   /// Whether service i runs on `host` ("" = this single host: every service of a single-host file).
   bool runsOn(std::size_t i, const std::string& host) const;
   /// argv of service i (argv[0] = exec as written); with security, `--security securityFile(i)` after
-  /// the --connect arguments.
-  std::vector<std::string> commandLine(std::size_t i) const;
+  /// the --connect arguments; with a checkpoint, `--checkpoint FILE`, and with `resume` `--resume FILE`.
+  std::vector<std::string> commandLine(std::size_t i, bool resume = false) const;
 
   /// Security: KEY_DIR/NAME.key and KEY_DIR/NAME.key_secret.
   std::string publicKeyFile(const std::string& key_name) const;

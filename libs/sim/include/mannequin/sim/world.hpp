@@ -247,6 +247,39 @@ struct DrivenFrame {
   const char* mode = "free";
 };
 
+/// A World's state as a restarted sim puts it back (World::checkpoint, World::restore; the sim service
+/// keeps one in its checkpoint file, simservice/checkpoint.hpp). Velocities are not part of it: what is
+/// restored starts at rest.
+struct MannequinCheckpoint {
+  std::string name;                 ///< instance name
+  std::string model;                ///< skeleton::Model::name (a restore into another model is refused)
+  skeleton::VectorX q;              ///< configuration (nq): root (p, rotation vector) then joints
+  bool calibrated = false;
+  skeleton::VectorX q_posture;      ///< q_c, the posture target set at calibration (nq; calibrated only)
+  /// A driven control frame's calibration (calibrated only; every driven frame, any order).
+  struct Frame {
+    std::string frame, body;
+    math::SE3 offset;               ///< bMf
+    math::SE3 target;               ///< world: the last target (held until the mocap drives it again)
+    double weight = 1.0;            ///< in [0, 1]
+  };
+  std::vector<Frame> frames;
+};
+
+/// A movable object's pose (PhysicsConfig scene objects).
+struct ObjectCheckpoint {
+  std::string name;
+  bool hinged = false;
+  math::SE3 pose;                   ///< world (free body)
+  double angle = 0.0;               ///< rad (hinged)
+};
+
+struct WorldCheckpoint {
+  std::uint64_t step = 0;           ///< step count (the World's time = step · δt)
+  std::vector<MannequinCheckpoint> mannequins;  ///< every mannequin of the World, any order
+  std::vector<ObjectCheckpoint> objects;        ///< every object of the World, any order
+};
+
 class World {
  public:
   /// \throws std::invalid_argument naming an unknown frame (with the model's frames), a step <= 0,
@@ -266,6 +299,19 @@ class World {
   std::vector<std::string> mocapSources() const;
   /// One fixed step. Returns false if a mannequin's step failed numerically (its state is kept).
   bool step();
+
+  //---- checkpoint / restore (a restarted sim resuming where it was) ----
+  /// The state restore() puts back.
+  WorldCheckpoint checkpoint() const;
+  /// Puts a checkpoint back: the step count (time), every mannequin's configuration and calibration
+  /// (q_c as posture target, every driven frame's offset bMf, last target and weight), every object's
+  /// pose. Velocities start at zero, mocap sources unanchored (their next frame anchors them).
+  /// Until then a restored calibrated mannequin holds its restored targets. Not restored: grasps, object
+  /// guides, the scenario's state (a checkpoint does not hold them: simservice/checkpoint.hpp says so in
+  /// its log); the balance controller starts again from q (a note in the returned list when it drove).
+  /// \throws std::invalid_argument, the World unchanged, naming the first mismatch: another set of
+  /// mannequins or objects, another model, a size, a non-finite number, another set of driven frames.
+  std::vector<std::string> restore(const WorldCheckpoint& checkpoint);
 
   double time() const { return static_cast<double>(steps_) * config_.step; }
   std::uint64_t stepCount() const { return steps_; }

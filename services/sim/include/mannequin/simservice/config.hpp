@@ -89,6 +89,11 @@ struct SimServiceConfig {
   /// The service ignores it (it gets mocap.frame). "" when absent.
   std::string mocap;
   ScenarioSettings scenario;  ///< key `scenario` (file "" when absent)
+  /// Command line only (simservice/checkpoint.hpp): the checkpoint file kept ("" none), written at most
+  /// every checkpoint_period s (at a sim.world publication), and the one to resume from at start ("" none).
+  std::string checkpoint;
+  double checkpoint_period = 0.1;
+  std::string resume;
 };
 
 /// Key `physics` (sim::PhysicsConfig, docs/cluster.md): {enabled, gravity, scene (a scene file, collision::loadScene),
@@ -121,6 +126,8 @@ class TriggerSchedule {
   explicit TriggerSchedule(const std::vector<TimedTrigger>& triggers) : triggers_(&triggers) {}
   /// Sends every trigger due at the World's time (at <= time + step/2); returns how many.
   int due(sim::World& world);
+  /// Skips the triggers timed before `time` (a World resumed from a checkpoint); returns how many.
+  std::size_t skipBefore(double time);
   std::size_t sent() const { return next_; }
 
  private:

@@ -28,6 +28,7 @@ struct SimStats {
   std::uint64_t contact_sets = 0;
   std::uint64_t stale_contacts = 0;
   std::uint64_t overruns = 0;   ///< live: steps started more than 10 ms late (then the pacing resynchronises)
+  std::uint64_t dropped_steps = 0;  ///< live: steps of wall time skipped by those resynchronisations (⌊lateness / δt⌋ each)
 };
 
 class SimService {
