@@ -412,7 +412,8 @@ int main(int argc, char** argv) {
   std::string reach_file;
   std::string snapshot_size = "640x360", view_file = "configs/views/desktop.yaml";
   app.add_option("--mocap", mocap,
-                 "capture: .bvh (the sim config's mocap map and bodies) or .c3d (--mapping); default: the sim config's own capture");
+                 "capture: .bvh (the sim config's mocap map and bodies), .c3d (--mapping) or .mcap (its mocap.frame, e.g. from "
+                 "mannequin-record); default: the sim config's own capture");
   app.add_option("--config,-c", config, "sim config (configs/sim/sim_*.yaml)")->capture_default_str();
   app.add_option("--mannequin", mannequin, "mannequin config (configs/mannequins/*.yaml)")->required();
   app.add_option("--compare", compare, "more mannequin configs, comma separated, run on the same capture side by side");

@@ -121,8 +121,8 @@ int main(int argc, char** argv) {
   double duration = -1;
   bool json = false;
   app.add_option("--config,-c", config_path, "sim config (configs/sim/sim_*.yaml)")->capture_default_str();
-  app.add_option("--mocap", mocap_bvh, "BVH capture replacing the file of the sim config's `mocap` config "
-                                       "(its map and bodies are kept)");
+  app.add_option("--mocap", mocap_bvh, "capture replacing the sim config's: a BVH file (the `mocap` config's map and "
+                                       "bodies kept), a .c3d or an .mcap recording (its mocap.frame messages)");
   app.add_option("--mannequin", mannequin, "mannequin config (configs/mannequins/*.yaml) for every mannequin");
   app.add_option("--scene", scene, "scene file (configs/scenes/*.yaml): turns the physics on with this scene");
   app.add_option("--scenario", scenario, "scenario file (configs/scenarios/*.yaml) run in the loop, replacing the sim "

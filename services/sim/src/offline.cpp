@@ -18,10 +18,13 @@
 #include "mannequin/mocap/bvh_source.hpp"
 #include "mannequin/mocap/c3d_source.hpp"
 #include "mannequin/proto/schema.hpp"
+#include "mannequin/recording/mcap_reader.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
 #include "mannequin/simservice/messages.hpp"
 #include "mannequin/transport/convert.hpp"
 #include "mannequin/transport/topics.hpp"
+#include "mannequin/transport/validate.hpp"
+#include "mannequin/v1/mocap.pb.h"
 
 namespace mannequin::simservice {
 
@@ -153,6 +156,68 @@ Capture openCapture(const std::string& mocap_path, const std::string& bvh_file) 
   return cap;
 }
 
+/// The mocap.frame messages of an MCAP recording (mannequin-record of a deployment, or any writer of the v1
+/// messages), in log-time order, once, unpaced: a capture replayed as the tracker streamed it.
+class RecordedCapture : public mocap::Source {
+ public:
+  /// \throws OfflineInputError naming the file (and the message) for an unreadable recording, one without
+  /// mocap.frame, a message that does not parse or is not a valid frame (NaN, ...), or several sources.
+  explicit RecordedCapture(const std::string& path) : path_(path) {
+    try {
+      const recording::McapReader reader = recording::McapReader::open(path);
+      bool has_topic = false;
+      std::string topics;
+      for (const auto& [id, ch] : reader.channels()) {
+        has_topic = has_topic || ch.topic == transport::topics::kMocapFrame.name;
+        topics += (topics.empty() ? "" : ", ") + ch.topic;
+      }
+      if (!has_topic)
+        throw OfflineInputError(fmt::format("{}: no {} messages (its topics: {})", path, transport::topics::kMocapFrame.name, topics.empty() ? "none" : topics));
+      recording::ReadFilter filter;
+      filter.topics = {std::string(transport::topics::kMocapFrame.name)};
+      recording::MessageCursor cursor = reader.messages(filter);
+      recording::Message m;
+      std::size_t index = 0;
+      std::set<std::string> sources;
+      v1::MocapFrame msg;
+      while (cursor.next(m)) {
+        if (!msg.ParseFromString(m.data))
+          throw OfflineInputError(fmt::format("{}: {} message {} (log time {} ns): not a mannequin.v1.MocapFrame", path,
+                                              transport::topics::kMocapFrame.name, index, m.log_time));
+        if (const std::string why = transport::validateMocapFrame(msg); !why.empty())
+          throw OfflineInputError(fmt::format("{}: {} message {} (log time {} ns): {}", path, transport::topics::kMocapFrame.name, index, m.log_time, why));
+        sources.insert(msg.header().source());
+        frames_.push_back(transport::fromMsg(msg));
+        ++index;
+      }
+      if (frames_.empty()) throw OfflineInputError(fmt::format("{}: the {} channel holds no message", path, transport::topics::kMocapFrame.name));
+      if (sources.size() > 1) {
+        std::string list;
+        for (const std::string& n : sources) list += (list.empty() ? "" : ", ") + n;
+        throw OfflineInputError(fmt::format("{}: mocap.frame of {} sources ({}); the offline run plays one capture", path, sources.size(), list));
+      }
+      source_name_ = *sources.begin();
+    } catch (const recording::McapError& e) {
+      throw OfflineInputError(e.what());
+    }
+  }
+  std::optional<mocap::Frame> next(std::chrono::microseconds) override {
+    if (next_ >= frames_.size()) return std::nullopt;
+    return frames_[next_++];
+  }
+  bool finished() const override { return next_ >= frames_.size(); }
+  std::string kind() const override { return "mcap"; }
+  std::string describe() const override {
+    return fmt::format("{}: {} recorded mocap.frame of '{}', {:.3f} s", path_, frames_.size(), source_name_, lengthS());
+  }
+  double lengthS() const { return static_cast<double>(frames_.back().stamp_ns - frames_.front().stamp_ns) * 1e-9; }
+
+ private:
+  std::string path_, source_name_;
+  std::vector<mocap::Frame> frames_;
+  std::size_t next_ = 0;
+};
+
 }  // namespace
 
 OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
@@ -182,7 +247,13 @@ OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
       needs_main = needs_main || !own_capture;
     }
     const bool c3d = !options.mocap.empty() && endsWith(options.mocap, ".c3d");
-    if (c3d && needs_main) {
+    const bool mcap = !options.mocap.empty() && endsWith(options.mocap, ".mcap");
+    if (mcap && needs_main) {
+      auto recorded = std::make_unique<RecordedCapture>(options.mocap);
+      capture_length_s_ = recorded->lengthS();
+      capture_file_ = options.mocap;
+      source_ = std::move(recorded);
+    } else if (c3d && needs_main) {
       // a C3D lab capture: the mocap library's `source: c3d`, its marker clusters as rigid bodies; the
       // mannequins driven by the control frames whose bodies the mapping has
       YAML::Node raw;

@@ -111,7 +111,8 @@ struct OfflineOptions {
   std::string config = "configs/sim/sim_demo.yaml";  ///< sim config (core::findData)
   /// A capture replacing the one of the sim config's `mocap` config: a .bvh (the mocap config's map and
   /// bodies kept), or a .c3d (source: c3d with `c3d_mapping`; the mannequins' control frames reduced
-  /// to the mapping's bodies). "" keeps the mocap config's.
+  /// to the mapping's bodies), or a .mcap recording (its mocap.frame messages, e.g. from mannequin-record,
+  /// in log-time order: the bodies as recorded, one source). "" keeps the mocap config's.
   std::string mocap;
   std::string c3d_mapping = "configs/mappings/c3d_sample01.yaml";
   std::string mannequin;  ///< mannequin config for every mannequin ("" keeps the sim config's)
