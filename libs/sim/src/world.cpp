@@ -150,6 +150,8 @@ struct World::Mannequin {
   std::vector<math::SE3> previous_targets;  // targets of the previous step (target twist)
   std::vector<bool> have_previous;
   std::vector<double> weights;  // current weights (rate-limited)
+  // after a stream gap: the offset (world, m and rotation vector) of each target from its body, shrinking at kCatchUpSpeed
+  std::vector<math::Vector3> catch_p, catch_r;
   bool calibrated = false;
   skeleton::VectorX q_standing;
   skeleton::VectorX q_posture;  // q_c: the posture target set at calibration
@@ -186,6 +188,8 @@ World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : conf
       m->frames.push_back(st);
     }
     m->weights.assign(m->frames.size(), 0.0);
+    m->catch_p.assign(m->frames.size(), math::Vector3::Zero());
+    m->catch_r.assign(m->frames.size(), math::Vector3::Zero());
     m->q_standing = skeleton::standingConfiguration(m->model);
     m->frame_indices = idx;
     if (s.controller && config_.physics.enabled) {
@@ -899,6 +903,7 @@ double World::soleGap(Mannequin& m, const skeleton::VectorX& q) {
 
 namespace {
 constexpr double kJumpTolerance = 0.05;  // m: noise of a tracked position over a frame
+constexpr double kCatchUpSpeed = 1.0;  // m/s: a target catching up with its body after a stream gap
 }  // namespace
 
 bool World::addMocap(const mocap::Frame& in, const std::string& source) {
@@ -993,8 +998,21 @@ void World::driveTargets(Mannequin& m, double dt) {
       // weights move towards their goal at 1/blend per second (back in after an occlusion: no jump)
       const double rate = dt / std::max(config_.occlusion_blend, 1e-9);
       double& w = m.weights[i];
-      if (src.back) w = 0.0;  // back after a gap: the targets may be far from the held ones, no yank
       w = goal > w ? std::min(goal, w + rate) : goal;
+      // back after a stream gap the body may be far from the held target: the target keeps the offset it
+      // had to the body then and the offset shrinks at kCatchUpSpeed (m/s, and kCatchUpSpeed / 0.3 m rad/s),
+      // so it moves with the body and reaches it without a jump
+      if (src.back && m.have_previous[i]) {
+        m.catch_p[i] = m.previous_targets[i].p - st.target.p;
+        m.catch_r[i] = math::logSO3(m.previous_targets[i].R * st.target.R.transpose());
+      }
+      if (m.catch_p[i].squaredNorm() > 0 || m.catch_r[i].squaredNorm() > 0) {
+        const auto shrink = [](math::Vector3& d, double by) { d = d.norm() <= by ? math::Vector3::Zero() : math::Vector3(d * (1.0 - by / d.norm())); };
+        shrink(m.catch_p[i], kCatchUpSpeed * dt);
+        shrink(m.catch_r[i], kCatchUpSpeed / 0.3 * dt);
+        st.target.p += m.catch_p[i];
+        st.target.R = math::expSO3(m.catch_r[i]) * st.target.R;
+      }
       // a target moving faster than max_target_speed (m/s) jumped (a marker swap, a re-tracked body, a
       // re-anchored clock): counted (its twist is not fed forward, targetTwist)
       if (m.have_previous[i] && (st.target.p - m.previous_targets[i].p).norm() > config_.max_target_speed * dt) ++glitches_.target_jumps;
