@@ -28,6 +28,12 @@ bool MocapBuffer::add(const mocap::Frame& frame) {
   return true;
 }
 
+void MocapBuffer::restart(const mocap::Frame& frame) {
+  frames_.clear();
+  for (LastTracked& l : last_tracked_) l.stamp_ns = frame.stamp_ns;
+  add(frame);
+}
+
 BodySample MocapBuffer::sample(const std::string& body, std::int64_t t_ns) const {
   BodySample out;
   for (const LastTracked& l : last_tracked_)

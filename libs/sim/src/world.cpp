@@ -132,6 +132,8 @@ struct World::Source {
   std::string name;
   MocapBuffer buffer{2.0};
   bool anchored = false;
+  bool gap = false;   // its newest frame is older than occlusion_hold (counted once per gap)
+  bool back = false;  // frames came back after a gap: the next step takes its frames in again from weight 0
   std::int64_t anchor_capture_ns = 0;
   std::uint64_t anchor_step = 0;
 };
@@ -148,6 +150,8 @@ struct World::Mannequin {
   std::vector<math::SE3> previous_targets;  // targets of the previous step (target twist)
   std::vector<bool> have_previous;
   std::vector<double> weights;  // current weights (rate-limited)
+  // after a stream gap: the offset (world, m and rotation vector) of each target from its body, shrinking at kCatchUpSpeed
+  std::vector<math::Vector3> catch_p, catch_r;
   bool calibrated = false;
   skeleton::VectorX q_standing;
   skeleton::VectorX q_posture;  // q_c: the posture target set at calibration
@@ -185,6 +189,8 @@ World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : conf
       m->frames.push_back(st);
     }
     m->weights.assign(m->frames.size(), 0.0);
+    m->catch_p.assign(m->frames.size(), math::Vector3::Zero());
+    m->catch_r.assign(m->frames.size(), math::Vector3::Zero());
     m->q_standing = skeleton::standingConfiguration(m->model);
     m->frame_indices = idx;
     if (s.controller && config_.physics.enabled) {
@@ -896,11 +902,61 @@ double World::soleGap(Mannequin& m, const skeleton::VectorX& q) {
   return gap;
 }
 
-bool World::addMocap(const mocap::Frame& frame, const std::string& source) {
+namespace {
+constexpr double kJumpTolerance = 0.05;  // m: noise of a tracked position over a frame
+constexpr double kCatchUpSpeed = 1.0;  // m/s: a target catching up with its body after a stream gap
+}  // namespace
+
+bool World::addMocap(const mocap::Frame& in, const std::string& source) {
   Source* src = findSource(source);
-  if (src == nullptr || !src->buffer.add(frame)) return false;
+  if (src == nullptr) return false;
+  const mocap::Frame* newest = src->buffer.newest();
+  const bool restart = newest != nullptr && newest->stamp_ns - in.stamp_ns > src->buffer.window_ns();
+  if (newest != nullptr && !restart && in.stamp_ns <= newest->stamp_ns) {
+    ++(in.stamp_ns == newest->stamp_ns ? glitches_.duplicate_frames : glitches_.out_of_order_frames);
+    return false;
+  }
+  // a tracked body with a non-finite pose (a glitch of the tracker) is taken as untracked
+  const mocap::Frame* frame = &in;
+  mocap::Frame clean;
+  for (const mocap::Body& b : in.bodies)
+    if (b.tracked && !(b.pose.p.allFinite() && b.pose.R.allFinite())) {
+      if (frame == &in) clean = in;
+      frame = &clean;
+    }
+  if (frame == &clean)
+    for (mocap::Body& b : clean.bodies)
+      if (b.tracked && !(b.pose.p.allFinite() && b.pose.R.allFinite())) {
+        b.tracked = false;
+        ++glitches_.non_finite_bodies;
+      }
+  // a tracked body farther from its last tracked pose than max_target_speed allows since then (a marker
+  // swap): untracked in this frame, so its target holds; a body that really moved is taken again once
+  // the time since its last tracked pose allows the distance
+  if (newest != nullptr && !restart)
+    for (std::size_t k = 0; k < frame->bodies.size(); ++k) {
+      const mocap::Body& b = frame->bodies[k];
+      if (!b.tracked) continue;
+      const BodySample last = src->buffer.sample(b.name, newest->stamp_ns + 1);
+      if (!last.ever_tracked) continue;
+      const double allowed = config_.max_target_speed * static_cast<double>(frame->stamp_ns - last.last_tracked_ns) * 1e-9 + kJumpTolerance;
+      if ((b.pose.p - last.pose.p).norm() <= allowed) continue;
+      if (frame == &in) clean = in;
+      frame = &clean;
+      clean.bodies[k].tracked = false;
+      ++glitches_.pose_jumps;
+    }
+  if (restart) {
+    ++glitches_.capture_restarts;
+    src->buffer.restart(*frame);
+    if (src->anchored) anchor(frame->stamp_ns, source);  // its clock: the service's anchoring, at the frame
+  } else {
+    src->buffer.add(*frame);
+  }
+  if (src->gap) src->back = true;  // the stream is back after a gap: its frames are taken in again
+  src->gap = false;
   for (auto& m : mannequins_)
-    if (!m->calibrated && sources_[static_cast<std::size_t>(m->source)].get() == src) calibrate(*m, frame);
+    if (!m->calibrated && sources_[static_cast<std::size_t>(m->source)].get() == src) calibrate(*m, *frame);
   return true;
 }
 
@@ -939,11 +995,29 @@ void World::driveTargets(Mannequin& m, double dt) {
                    ? 1.0
                    : std::max(0.0, 1.0 - (since - config_.occlusion_hold) / std::max(config_.occlusion_blend, 1e-9));
       }
+      if (st.tracked && !s.tracked) ++glitches_.occlusions;
       st.tracked = s.tracked;
       // weights move towards their goal at 1/blend per second (back in after an occlusion: no jump)
       const double rate = dt / std::max(config_.occlusion_blend, 1e-9);
       double& w = m.weights[i];
       w = goal > w ? std::min(goal, w + rate) : goal;
+      // back after a stream gap the body may be far from the held target: the target keeps the offset it
+      // had to the body then and the offset shrinks at kCatchUpSpeed (m/s, and kCatchUpSpeed / 0.3 m rad/s),
+      // so it moves with the body and reaches it without a jump
+      if (src.back && m.have_previous[i]) {
+        m.catch_p[i] = m.previous_targets[i].p - st.target.p;
+        m.catch_r[i] = math::logSO3(m.previous_targets[i].R * st.target.R.transpose());
+      }
+      if (m.catch_p[i].squaredNorm() > 0 || m.catch_r[i].squaredNorm() > 0) {
+        const auto shrink = [](math::Vector3& d, double by) { d = d.norm() <= by ? math::Vector3::Zero() : math::Vector3(d * (1.0 - by / d.norm())); };
+        shrink(m.catch_p[i], kCatchUpSpeed * dt);
+        shrink(m.catch_r[i], kCatchUpSpeed / 0.3 * dt);
+        st.target.p += m.catch_p[i];
+        st.target.R = math::expSO3(m.catch_r[i]) * st.target.R;
+      }
+      // a target moving faster than max_target_speed (m/s) jumped (a marker swap, a re-tracked body, a
+      // re-anchored clock): counted (its twist is not fed forward, targetTwist)
+      if (m.have_previous[i] && (st.target.p - m.previous_targets[i].p).norm() > config_.max_target_speed * dt) ++glitches_.target_jumps;
       m.stepper->setTarget(static_cast<int>(i), st.target, targetTwist(m, i, dt), w);
     }
   } else {
@@ -1307,7 +1381,14 @@ void World::updateSupport() {
 bool World::step() {
   const double dt = config_.step;
   bool ok = true;
+  for (auto& src : sources_)
+    if (const mocap::Frame* f = src->buffer.newest(); f != nullptr && src->anchored && !src->gap &&
+                                                       captureTimeNs(src->name) - f->stamp_ns > std::llround(config_.occlusion_hold * 1e9)) {
+      src->gap = true;
+      ++glitches_.stream_gaps;
+    }
   for (auto& mp : mannequins_) driveTargets(*mp, dt);
+  for (auto& src : sources_) src->back = false;
   if (physics_ && !physics_->balance_loops.empty())
     for (std::size_t m = 0; m < mannequins_.size(); ++m) applyBalanceTargets(m);
   if (scenario_) stepScenario();

@@ -66,6 +66,16 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
   if (contacts != nullptr) out.set_contacts_step(contacts->step());
   const collision::CollisionWorld* cw = world.physics() ? world.collisionWorld() : nullptr;
   if (cw != nullptr) toDiagnostics(world.diagnostics(), replay, *out.mutable_diagnostics());
+  const sim::MocapGlitches& g = world.mocapGlitches();
+  v1::MocapGlitches& gm = *out.mutable_mocap_glitches();
+  gm.set_duplicate_frames(g.duplicate_frames);
+  gm.set_out_of_order_frames(g.out_of_order_frames);
+  gm.set_capture_restarts(g.capture_restarts);
+  gm.set_non_finite_bodies(g.non_finite_bodies);
+  gm.set_occlusions(g.occlusions);
+  gm.set_target_jumps(g.target_jumps);
+  gm.set_stream_gaps(g.stream_gaps);
+  gm.set_pose_jumps(g.pose_jumps);
   const auto frameRef = [](const mocap::Frame& m, const std::string& source, v1::FrameRef& r) {
     r.set_sequence(m.sequence);
     r.set_stamp_ns(m.stamp_ns);

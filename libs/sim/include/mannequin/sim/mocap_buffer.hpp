@@ -33,6 +33,11 @@ class MocapBuffer {
   const mocap::Frame* newest() const { return frames_.empty() ? nullptr : &frames_.back(); }
   std::size_t size() const { return frames_.size(); }
   void clear() { frames_.clear(); last_tracked_.clear(); }
+  /// A restarted capture clock: drops the frames, keeps each body's last tracked pose as if seen at
+  /// `stamp_ns` (so the occlusion hold starts again there), then adds `frame`.
+  void restart(const mocap::Frame& frame);
+  /// Capture-time span of the frames kept (ns).
+  std::int64_t window_ns() const { return window_ns_; }
 
  private:
   struct LastTracked {

@@ -229,6 +229,30 @@ struct StepDiagnostics {
   double collision_s = 0, free_motion_s = 0, constraints_s = 0, integrate_s = 0;  ///< wall time per stage
 };
 
+/// Mocap glitches the World met, counted per kind over its life (all sources); sim.world carries them
+/// (`mocap_glitches`), docs/cluster.md "Faults".
+struct MocapGlitches {
+  std::uint64_t duplicate_frames = 0;     ///< a frame with its source's newest capture time: ignored
+  std::uint64_t out_of_order_frames = 0;  ///< a frame older than the newest, by at most the buffer window: ignored
+  /// A frame older than the newest by more than the buffer window (2 s): a restarted capture clock (a
+  /// restarted mocap service); the source's buffer starts again from it and, anchored, is re-anchored.
+  std::uint64_t capture_restarts = 0;
+  std::uint64_t non_finite_bodies = 0;    ///< tracked bodies with a NaN/inf pose: taken as untracked
+  /// Tracked bodies farther from their last tracked position than `max_target_speed` m/s × the time
+  /// since (+ 5 cm): a marker swap, taken as untracked (held) until the elapsed time allows the distance.
+  std::uint64_t pose_jumps = 0;
+  std::uint64_t occlusions = 0;           ///< a driven body went from tracked to untracked
+  /// Steps where a driven frame's target position moved faster than `max_target_speed` m/s (a 2 m marker
+  /// swap, a re-tracked body, a re-anchored clock; fast real motion of a hand body's offset too): its
+  /// twist is not fed forward.
+  std::uint64_t target_jumps = 0;
+  /// A source's newest frame got older than `occlusion_hold` at its capture time (the stream stopped: a
+  /// mocap service died, a network gap). Its bodies keep their last targets at full weight (the whole
+  /// actor held: blending every frame out let the mannequin sag). When frames come back, each target keeps
+  /// the offset it then has to its body, shrinking at 1 m/s (and 3.3 rad/s): it catches up without a jump.
+  std::uint64_t stream_gaps = 0;
+};
+
 /// A control frame driven by a mocap body, after a step: the World's calibration (bMf), the target it
 /// derives from the body, and how well the mannequin follows it. The controller's coupling on the same
 /// frame (gains, wrench, port energy) is control::ControlFrameState. The wire's v1::ControlFrameState is
@@ -287,8 +311,10 @@ class World {
   World(std::vector<MannequinSetup> mannequins, const SimConfig& config);
   ~World();
 
-  /// Adds a mocap frame of `source` (ignored if not newer than that source's last). Calibrates the
-  /// mannequins it drives when possible. Returns false for a frame ignored or a source no mannequin uses.
+  /// Adds a mocap frame of `source` (ignored if not newer than that source's last, unless it is older by
+  /// more than the buffer window: a restarted capture clock, MocapGlitches::capture_restarts). Tracked
+  /// bodies with a non-finite pose are taken as untracked. Calibrates the mannequins it drives when
+  /// possible. Returns false for a frame ignored or a source no mannequin uses.
   bool addMocap(const mocap::Frame& frame, const std::string& source = "");
   /// Ties the World clock to a source's capture clock: now, that source's capture time is `capture_ns`.
   void anchor(std::int64_t capture_ns, const std::string& source = "");
@@ -329,6 +355,8 @@ class World {
   /// The newest mocap frame added to `source` (nullptr before any, or an unknown source).
   const mocap::Frame* latestMocap(const std::string& source = "") const;
   std::uint64_t failedSteps() const { return failed_steps_; }
+  /// The mocap glitches met so far (MocapGlitches).
+  const MocapGlitches& mocapGlitches() const { return glitches_; }
 
   //---- physics (PhysicsConfig::enabled) ----
   bool physics() const { return config_.physics.enabled; }
@@ -428,6 +456,7 @@ class World {
   SimConfig config_;
   std::vector<std::unique_ptr<Source>> sources_;  // "" first
   std::uint64_t steps_ = 0, failed_steps_ = 0;
+  MocapGlitches glitches_;
   struct ScenarioRun;
   std::unique_ptr<ScenarioRun> scenario_;
   void stepScenario();
