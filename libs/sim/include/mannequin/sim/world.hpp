@@ -240,6 +240,7 @@ struct MocapGlitches {
   std::uint64_t non_finite_bodies = 0;    ///< tracked bodies with a NaN/inf pose: taken as untracked
   /// Tracked bodies farther from their last tracked position than `max_target_speed` m/s × the time
   /// since (+ 5 cm): a marker swap, taken as untracked (held) until the elapsed time allows the distance.
+  /// Not when every tracked body of the frame jumps (the actor relocated, a looping capture's wrap): taken as is.
   std::uint64_t pose_jumps = 0;
   std::uint64_t occlusions = 0;           ///< a driven body went from tracked to untracked
   /// Steps where a driven frame's target position moved faster than `max_target_speed` m/s (a 2 m marker
@@ -317,6 +318,8 @@ class World {
   /// possible. Returns false for a frame ignored or a source no mannequin uses.
   bool addMocap(const mocap::Frame& frame, const std::string& source = "");
   /// Ties the World clock to a source's capture clock: now, that source's capture time is `capture_ns`.
+  /// Again (a re-anchor: the clocks drifted, frames came in a burst): the targets jump in capture time, so
+  /// they catch up with their bodies at 1 m/s as after a stream gap (MocapGlitches::stream_gaps).
   void anchor(std::int64_t capture_ns, const std::string& source = "");
   bool anchored(const std::string& source = "") const;
   /// Capture time (ns) of `source` the next step samples targets at.
@@ -457,6 +460,7 @@ class World {
   std::vector<std::unique_ptr<Source>> sources_;  // "" first
   std::uint64_t steps_ = 0, failed_steps_ = 0;
   MocapGlitches glitches_;
+  std::vector<std::size_t> jumps_;  // addMocap: the bodies of a frame that jumped (kept: no allocation per frame)
   struct ScenarioRun;
   std::unique_ptr<ScenarioRun> scenario_;
   void stepScenario();
