@@ -988,10 +988,14 @@ math::Vector6 World::targetTwist(Mannequin& m, std::size_t i, double dt) const {
 void World::driveTargets(Mannequin& m, double dt) {
   const Source& src = *sources_[static_cast<std::size_t>(m.source)];
   if (m.calibrated && src.anchored) {
+    // restored (World::restore) and holding its targets until now: the first live targets catch up from the
+    // held ones, as after a stream gap (the actor may have moved while the sim was down)
+    const bool was_holding = m.holding_restored;
     m.holding_restored = false;
     const std::int64_t t = captureTimeNs(src.name);
     for (std::size_t i = 0; i < m.frames.size(); ++i) {
       DrivenFrame& st = m.frames[i];
+      const math::SE3 held = st.target;
       const BodySample s = src.buffer.sample(st.body, t);
       double goal = 1.0;
       if (s.tracked) {
@@ -1012,7 +1016,10 @@ void World::driveTargets(Mannequin& m, double dt) {
       // back after a stream gap (or re-anchored) the body may be far from the target: the target keeps the offset it
       // had to the body then and the offset shrinks at kCatchUpSpeed (m/s, and kCatchUpSpeed / 0.3 m rad/s),
       // so it moves with the body and reaches it without a jump
-      if (src.back && m.have_previous[i]) {
+      if (was_holding) {
+        m.catch_p[i] = held.p - st.target.p;
+        m.catch_r[i] = math::logSO3(held.R * st.target.R.transpose());
+      } else if (src.back && m.have_previous[i]) {
         m.catch_p[i] = m.previous_targets[i].p - st.target.p;
         m.catch_r[i] = math::logSO3(m.previous_targets[i].R * st.target.R.transpose());
       }
