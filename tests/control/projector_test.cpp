@@ -38,6 +38,47 @@ void expectSameProjector(const MatrixX& J, const VectorX& w, int expected_rank) 
   EXPECT_LT((P1 * P1 - P1).norm() / scale, 1e-8);
   EXPECT_LT((J * w_inv.asDiagonal() * P1.transpose()).norm() / (1 + J.norm()), 1e-8);
 }
+
+/// Π of PriorityGramFactor for the first m rows, dense (columns of Πᵀ are Πᵀ e_k).
+MatrixX priorityProjector(PriorityGramFactor& f, const MatrixX& J, const VectorX& w_inv, int m) {
+  MatrixX PiT(J.cols(), J.cols());
+  VectorX e(J.cols()), col(J.cols());
+  for (int k = 0; k < J.cols(); ++k) {
+    e.setZero();
+    e(k) = 1.0;
+    f.projectTorque(J, w_inv, m, e, col);
+    PiT.col(k) = col;
+  }
+  return PiT.transpose();
+}
+
+/// One unpivoted factorisation of J's Gram gives, for every prefix of rows, the projector and rank of
+/// the reference SVD projector of those rows alone.
+void expectPrefixProjectors(const MatrixX& J, const VectorX& w, double svd_tolerance) {
+  const VectorX w_inv = w.cwiseInverse();
+  const int rows = static_cast<int>(J.rows()), n = static_cast<int>(J.cols());
+  PriorityGramFactor f(rows, n, 1e-9);
+  const MatrixX G = J * w_inv.asDiagonal() * J.transpose();
+  MatrixX lower = G.triangularView<Eigen::Lower>();  // only the lower triangle is read
+  f.compute(lower);
+  for (int m = 0; m <= rows; ++m) {
+    SCOPED_TRACE("prefix of " + std::to_string(m) + " rows");
+    const MatrixX Jm = J.topRows(m);
+    const MatrixX P = priorityProjector(f, J, w_inv, m);
+    const MatrixX Pref = m == 0 ? MatrixX(MatrixX::Identity(n, n)) : math::weightedNullSpaceProjector(Jm, MatrixX(w.asDiagonal()), svd_tolerance);
+    const double scale = 1.0 + Pref.norm();
+    EXPECT_LT((P - Pref).norm() / scale, 1e-8);
+    EXPECT_LT((P * P - P).norm() / scale, 1e-8);  // idempotent
+    if (m > 0) {
+      EXPECT_LT((Jm * P).norm() / (1 + Jm.norm()), 1e-8);  // J Π = 0
+      const Eigen::JacobiSVD<MatrixX> svd(Jm * w_inv.cwiseSqrt().asDiagonal());
+      int rank = 0;
+      for (int i = 0; i < svd.singularValues().size(); ++i)
+        if (svd.singularValues()(i) > std::sqrt(svd_tolerance) * svd.singularValues()(0)) ++rank;
+      EXPECT_EQ(f.rank(m), rank);
+    }
+  }
+}
 }  // namespace
 
 TEST(Projector, LdltEqualsSvdOnRandomFullRank) {
@@ -76,6 +117,39 @@ TEST(Projector, MannequinAllFramesStandingStraightLegs) {
     if (svd.singularValues()(i) > 1e-4 * svd.singularValues()(0)) ++rank;
   EXPECT_LT(rank, 36);
   expectSameProjector(J, ctl.frictionDiagonal(), rank);
+}
+
+TEST(PriorityGramFactor, EveryPrefixGivesTheProjectorOfItsRowsOnRandomAndRankDeficientTasks) {
+  std::mt19937 rng(3);
+  std::uniform_real_distribution<double> u(0.5, 20.0);
+  MatrixX J = randomMatrix(12, 20, rng);
+  VectorX w(20);
+  for (int i = 0; i < 20; ++i) w(i) = u(rng);
+  expectPrefixProjectors(J, w, 1e-9);
+  // dependent rows (on rows before them and on later rows' predecessors), a zero row (a disabled frame's)
+  J.row(7) = 2.0 * J.row(1) - J.row(3);
+  J.row(9).setZero();
+  J.row(4) = -J.row(0);
+  expectPrefixProjectors(J, w, 1e-9);
+  PriorityGramFactor f(12, 20, 1e-9);
+  f.compute(J * w.cwiseInverse().asDiagonal() * J.transpose());
+  EXPECT_EQ(f.rank(12), 9);
+  EXPECT_EQ(f.rank(5), 4);  // row 4 = −row 0 is dropped within the first five
+  // bad use is refused
+  EXPECT_THROW(PriorityGramFactor(3, 5, 1.0), std::invalid_argument);
+  EXPECT_THROW(f.compute(MatrixX::Zero(3, 3)), std::invalid_argument);
+  VectorX g = VectorX::Ones(20), out;
+  EXPECT_THROW(f.projectTorque(J, w, 13, g, out), std::invalid_argument);
+}
+
+TEST(PriorityGramFactor, MannequinPrioritisedFramesAtTheStandingPosture) {
+  // the controller's J (rows in priority order) at straight knees, where the 36 rows lose rank: every
+  // prefix's projector and rank as the SVD of those rows
+  const auto& model = male50();
+  ControllerConfig c = loadControllerConfig(sourceDir() + "/configs/control/default.yaml");
+  Controller ctl(model, c);
+  ctl.computeFreeMotion();
+  expectPrefixProjectors(ctl.taskJacobian(), ctl.frictionDiagonal(), 1e-8);
 }
 
 TEST(Projector, EmptyTaskIsIdentity) {

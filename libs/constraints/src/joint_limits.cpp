@@ -340,7 +340,7 @@ bool JointLimitRows::refine(int id, double dt, RowSet& rows, const std::vector<E
     const skeleton::BallLimit& l = j.ball_limit;
     const Eigen::Vector3d w = v.segment<3>(j.idx_v);
     if (b.joint != joint) {  // where the step takes the ball: R_k exp(δt ω), as the controller integrates
-      next = ballLimitDistances(l, ball_R_[static_cast<std::size_t>(b.ball)] * math::expSO3(dt * w));
+      next = ballLimitDistances(l, ball_R_[static_cast<std::size_t>(b.ball)] * math::expSO3(dt * w), false);
       joint = b.joint;
     }
     double d_next;
@@ -387,7 +387,7 @@ bool JointLimitRows::refine(int id, double dt, RowSet& rows, const std::vector<E
       ball_d_[bi] = ballLimitDistances(l, ball_R_[bi]);
       ball_eval_[bi] = 1;
     }
-    const BallLimitDistances n1 = ballLimitDistances(l, ball_R_[bi] * math::expSO3(dt * w));
+    const BallLimitDistances n1 = ballLimitDistances(l, ball_R_[bi] * math::expSO3(dt * w), false);
     if (n1.swing_excess <= 0.0 && (n1.singular || (n1.twist_lower >= 0.0 && n1.twist_upper >= 0.0))) continue;
     const BallLimitDistances& d = ball_d_[bi];
     double c[3];

@@ -10,7 +10,7 @@ using Eigen::Matrix3d;
 using Eigen::RowVector3d;
 using Eigen::Vector3d;
 
-SwingTwist swingTwist(const Matrix3d& R, const Vector3d& t, const Vector3d& fallback) {
+SwingTwist swingTwist(const Matrix3d& R, const Vector3d& t, const Vector3d& fallback, bool jacobians) {
   SwingTwist st;
   const Vector3d z1 = R * t;
   const Vector3d w = t.cross(z1);
@@ -36,16 +36,15 @@ SwingTwist swingTwist(const Matrix3d& R, const Vector3d& t, const Vector3d& fall
     f = (sin_t - th * cos_t) / (sin_t * sin_t * sin_t);
   }
   st.swing = sin_t > 1e-12 || th < 1e-3 ? Vector3d(g * w) : Vector3d(th * st.swing_dir);
-  // dθ_s/dω = (t × Rᵀ e_θ)ᵀ, e_θ the direction in which z1 moves when θ_s grows
-  const Vector3d e_th = -std::sin(th) * t + std::cos(th) * st.swing_dir.cross(t);
-  st.swing_angle_jacobian = t.cross(R.transpose() * e_th).transpose();
   // the twist: R_t = R_sᵀ R, signed angle about t
   const Matrix3d Rt = math::expSO3(st.swing).transpose() * R;
   st.twist = std::atan2(t.dot(math::vee(Rt)), 0.5 * (Rt.trace() - 1.0));
-  if (th > kSwingSingular) {
-    st.singular = true;
-    return st;
-  }
+  st.singular = th > kSwingSingular;
+  if (!jacobians) return st;
+  // dθ_s/dω = (t × Rᵀ e_θ)ᵀ, e_θ the direction in which z1 moves when θ_s grows
+  const Vector3d e_th = -std::sin(th) * t + std::cos(th) * st.swing_dir.cross(t);
+  st.swing_angle_jacobian = t.cross(R.transpose() * e_th).transpose();
+  if (st.singular) return st;
   const Matrix3d T = math::hat(t);
   st.swing_jacobian = T * (f * z1 * t.transpose() - g * Matrix3d::Identity()) * R * T;  // (61)
   st.twist_jacobian = t.transpose() - t.transpose() * math::rightJacobianSO3(st.swing) * st.swing_jacobian;
@@ -76,16 +75,16 @@ double ellipseRadius(const skeleton::BallLimit& l, const Vector3d& u) {
   return (B + std::sqrt(std::max(0.0, B * B - A * C))) / A;
 }
 
-BallLimitDistances ballLimitDistances(const skeleton::BallLimit& l, const Matrix3d& R) {
+BallLimitDistances ballLimitDistances(const skeleton::BallLimit& l, const Matrix3d& R, bool jacobians) {
   BallLimitDistances d;
-  d.st = swingTwist(R, l.twist_axis, l.swing_x);
+  d.st = swingTwist(R, l.twist_axis, l.swing_x, jacobians);
   const SwingTwist& st = d.st;
   const double rho = ellipseRadius(l, st.swing_dir);
   d.swing_excess = std::max(0.0, st.swing_angle - rho);
   if (st.singular) {
     d.singular = true;
     d.swing = rho - st.swing_angle;
-    d.swing_jacobian = -st.swing_angle_jacobian;
+    if (jacobians) d.swing_jacobian = -st.swing_angle_jacobian;
     return d;
   }
   // κ = 1/(dh/dρ along u at the boundary) = 1/(2 uᵀQ(ρu − c))
@@ -93,9 +92,10 @@ BallLimitDistances ballLimitDistances(const skeleton::BallLimit& l, const Matrix
   const double slope = ellipseGradient(l, rho * u).dot(u);
   d.swing_scale = slope > 1e-12 ? 1.0 / slope : 0.5 * std::min(l.swing_a, l.swing_b);
   d.swing = d.swing_scale * (1.0 - ellipseLevel(l, st.swing));
-  d.swing_jacobian = -d.swing_scale * ellipseGradient(l, st.swing) * st.swing_jacobian;
   d.twist_lower = st.twist - l.twist_lower;
   d.twist_upper = l.twist_upper - st.twist;
+  if (!jacobians) return d;
+  d.swing_jacobian = -d.swing_scale * ellipseGradient(l, st.swing) * st.swing_jacobian;
   d.twist_jacobian = st.twist_jacobian;
   return d;
 }

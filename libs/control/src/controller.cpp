@@ -151,9 +151,13 @@ void Controller::build(const VectorX& q0) {
     if (k == 0 || frames_[order_[k]].priority != frames_[order_[k - 1]].priority) level_begin_.push_back(k);
   }
   level_projectors_.clear();
-  for (size_t l = 0; l < level_begin_.size(); ++l)
-    level_projectors_.emplace_back(6 * level_begin_[l], nv_, c.projector, c.rank_tolerance);
-  internal_projector_ = WeightedNullSpace(rows_, nv_, c.projector, c.rank_tolerance);
+  if (c.projector == ProjectorMethod::kSvd) {
+    for (size_t l = 0; l < level_begin_.size(); ++l)
+      level_projectors_.emplace_back(6 * level_begin_[l], nv_, c.projector, c.rank_tolerance);
+    internal_projector_ = WeightedNullSpace(rows_, nv_, c.projector, c.rank_tolerance);
+  } else {
+    gram_factor_ = PriorityGramFactor(rows_, nv_, c.rank_tolerance);
+  }
   frame_pairs_.clear();
   for (int a = 0; a < nf; ++a)
     for (int b = 0; b < nf; ++b) {
@@ -426,6 +430,11 @@ void Controller::gramOfTasks() {
   }
 }
 
+void Controller::factorGramOfTasks() {
+  gramOfTasks();
+  gram_factor_.compute(gram_);
+}
+
 StepStatus Controller::computeFreeMotion() {
   frameKinematics();
   couplingTerms();
@@ -452,10 +461,14 @@ StepStatus Controller::computeFreeMotion() {
       gamma_level_.noalias() += J_.middleRows<6>(frame_row_[i]).transpose() * wrench_ff_[i];
     }
     if (l > 0) {
-      if (!gram_ready) gramOfTasks();
-      gram_ready = true;
-      level_projectors_[l].computeWithGram(J_.topRows(6 * k0), b_a_inv_, gram_.topLeftCorner(6 * k0, 6 * k0));
-      level_projectors_[l].projectTorque(gamma_level_, gamma_level_);
+      if (config_.projector == ProjectorMethod::kSvd) {
+        level_projectors_[l].compute(J_.topRows(6 * k0), b_a_inv_);
+        level_projectors_[l].projectTorque(gamma_level_, gamma_level_);
+      } else {
+        if (!gram_ready) factorGramOfTasks();
+        gram_ready = true;
+        gram_factor_.projectTorque(J_, b_a_inv_, 6 * k0, gamma_level_, gamma_level_);
+      }
     }
     gamma_task_ += gamma_level_;
   }
@@ -467,10 +480,14 @@ StepStatus Controller::computeFreeMotion() {
     const double alpha = observer_.alpha();
     gamma0_ = alpha * (k_int_.cwiseProduct(dq_int_) - b_int_.cwiseProduct(qdot_prev_));
     if (config_.internal.projection == InternalProjection::kDynamic && rows_ > 0) {
-      if (!gram_ready) gramOfTasks();
-      gram_ready = true;
-      internal_projector_.computeWithGram(J_, b_a_inv_, gram_);
-      internal_projector_.projectTorque(gamma0_, gamma_level_);
+      if (config_.projector == ProjectorMethod::kSvd) {
+        internal_projector_.compute(J_, b_a_inv_);
+        internal_projector_.projectTorque(gamma0_, gamma_level_);
+      } else {
+        if (!gram_ready) factorGramOfTasks();
+        gram_ready = true;
+        gram_factor_.projectTorque(J_, b_a_inv_, rows_, gamma0_, gamma_level_);
+      }
     } else {
       gamma_level_ = gamma0_;
     }

@@ -1,5 +1,7 @@
 #include "mannequin/control/projector.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <stdexcept>
 
 namespace mannequin::control {
@@ -122,6 +124,78 @@ MatrixX WeightedNullSpace::matrix() {
     PiT.col(k) = col;
   }
   return PiT.transpose();
+}
+
+PriorityGramFactor::PriorityGramFactor(int rows, int n, double rank_tolerance) : rows_(rows), n_(n), tol_(rank_tolerance) {
+  if (rows < 0 || n <= 0) throw std::invalid_argument("PriorityGramFactor: bad size");
+  if (!(rank_tolerance > 0) || !(rank_tolerance < 1))
+    throw std::invalid_argument("PriorityGramFactor: rank tolerance must be in (0, 1)");
+  L_.setZero(rows, rows);
+  d_.setZero(rows);
+  v_.setZero(rows);
+  y_.setZero(rows);
+  t_.setZero(n);
+}
+
+void PriorityGramFactor::compute(const Eigen::Ref<const MatrixX>& G) {
+  if (G.rows() != rows_ || G.cols() != rows_)
+    throw std::invalid_argument("PriorityGramFactor::compute: G is " + std::to_string(G.rows()) + "x" +
+                                std::to_string(G.cols()) + ", expected " + std::to_string(rows_) + "x" + std::to_string(rows_));
+  double gmax = 0.0;
+  for (int k = 0; k < rows_; ++k) {
+    // row k of L: L_kj = (G_kj − Σ_{p<j} L_kp d_p L_jp) / d_j, then d_k = G_kk − Σ_{j<k} L_kj² d_j
+    double* Lk = L_.row(k).data();
+    double dk = G(k, k);
+    for (int j = 0; j < k; ++j) {
+      if (d_(j) > 0.0) {
+        const double* Lj = L_.row(j).data();
+        double s = G(k, j);
+        for (int p = 0; p < j; ++p) s -= v_(p) * Lj[p];
+        Lk[j] = s / d_(j);
+        v_(j) = Lk[j] * d_(j);
+        dk -= Lk[j] * v_(j);
+      } else {
+        Lk[j] = 0.0;
+        v_(j) = 0.0;
+      }
+    }
+    if (std::isfinite(G(k, k))) gmax = std::max(gmax, G(k, k));
+    d_(k) = std::isfinite(dk) && dk > tol_ * gmax ? dk : 0.0;
+  }
+}
+
+void PriorityGramFactor::projectTorque(const Eigen::Ref<const MatrixX>& J, const VectorX& w_inv, int m, const VectorX& g,
+                                       VectorX& out) {
+  if (J.rows() != rows_ || J.cols() != n_ || w_inv.size() != n_ || g.size() != n_ || m < 0 || m > rows_)
+    throw std::invalid_argument("PriorityGramFactor::projectTorque: wrong size");
+  if (m == 0) {
+    if (&out != &g) out = g;
+    return;
+  }
+  // y = J_m W⁻¹ g; z = L⁻ᵀ D⁺ L⁻¹ y; out = g − J_mᵀ z
+  t_ = w_inv.cwiseProduct(g);
+  auto y = y_.head(m);
+  y.noalias() = J.topRows(m) * t_;
+  for (int k = 0; k < m; ++k) {
+    const double* Lk = L_.row(k).data();
+    double s = y(k);
+    for (int j = 0; j < k; ++j) s -= Lk[j] * y(j);
+    y(k) = s;
+  }
+  for (int k = 0; k < m; ++k) y(k) = d_(k) > 0.0 ? y(k) / d_(k) : 0.0;
+  for (int k = m - 1; k > 0; --k) {
+    const double* Lk = L_.row(k).data();
+    const double zk = y(k);
+    for (int j = 0; j < k; ++j) y(j) -= Lk[j] * zk;
+  }
+  t_.noalias() = J.topRows(m).transpose() * y;
+  out = g - t_;
+}
+
+int PriorityGramFactor::rank(int m) const {
+  int r = 0;
+  for (int k = 0; k < std::min(m, rows_); ++k) r += d_(k) > 0.0 ? 1 : 0;
+  return r;
 }
 
 AugmentedImpedance augmentedImpedance(const MatrixX& J, const VectorX& b_a_diag, double rank_tolerance) {

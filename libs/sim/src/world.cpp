@@ -29,8 +29,14 @@ double worstLimitExcess(const skeleton::Model& model, const skeleton::VectorX& q
   for (const skeleton::Joint& j : model.joints) {
     if (j.type == skeleton::JointType::kFreeFlyer) continue;
     if (j.type == skeleton::JointType::kBall) {
-      const constraints::BallLimitDistances bd =
-          constraints::ballLimitDistances(j.ball_limit, math::expSO3(q.segment<3>(j.idx_q)));
+      // the rotation angle θ = |q| bounds the swing angle and |twist| (swing_twist.hpp), and every point of
+      // the swing ellipse is at least min(a, b) − |c| from s = 0: inside both, nothing to decompose
+      const skeleton::BallLimit& l = j.ball_limit;
+      const double theta = q.segment<3>(j.idx_q).norm();
+      if (theta < std::min(l.swing_a, l.swing_b) - std::hypot(l.swing_cx, l.swing_cy) && theta < -l.twist_lower &&
+          theta < l.twist_upper)
+        continue;
+      const constraints::BallLimitDistances bd = constraints::ballLimitDistances(l, math::expSO3(q.segment<3>(j.idx_q)), false);
       worst = std::max(worst, bd.swing_excess);
       if (!bd.singular) worst = std::max({worst, -bd.twist_lower, -bd.twist_upper});
       continue;

@@ -37,9 +37,10 @@ struct SwingTwist {
 };
 
 /// Decomposes R about the unit axis t. `fallback` (unit, ⟂ t) is the swing direction used when
-/// θ_s = π exactly and t × z1 vanishes. Never throws; no allocation.
+/// θ_s = π exactly and t × z1 vanishes. Never throws; no allocation. With `jacobians` false only the
+/// values (θ_s, s, u, θ_t, singular) are computed — the same numbers — and the Jacobians stay zero.
 SwingTwist swingTwist(const Eigen::Matrix3d& R, const Eigen::Vector3d& t,
-                      const Eigen::Vector3d& fallback = Eigen::Vector3d::UnitX());
+                      const Eigen::Vector3d& fallback = Eigen::Vector3d::UnitX(), bool jacobians = true);
 
 /// R_s and R_t of a decomposition: R = swingRotation(st) * twistRotation(st, t).
 Eigen::Matrix3d swingRotation(const SwingTwist& st);
@@ -71,6 +72,8 @@ struct BallLimitDistances {
   SwingTwist st;
 };
 
-BallLimitDistances ballLimitDistances(const skeleton::BallLimit& l, const Eigen::Matrix3d& R);
+/// With `jacobians` false only the distances (and swing_scale, swing_excess, singular, st's values) are
+/// computed — the same numbers — for callers that need no rows (a refinement's look-ahead, diagnostics).
+BallLimitDistances ballLimitDistances(const skeleton::BallLimit& l, const Eigen::Matrix3d& R, bool jacobians = true);
 
 }  // namespace mannequin::constraints

@@ -219,6 +219,10 @@ class Controller {
   std::vector<FramePair> frame_pairs_;
   MatrixX gram_;   // (rows × rows) J b_a⁻¹ Jᵀ, lower triangle
   void gramOfTasks();
+  void factorGramOfTasks();  // gramOfTasks() and gram_factor_ of it
+  // projector: ldlt — one unpivoted factorisation of gram_ serves every level and the internal control
+  PriorityGramFactor gram_factor_;
+  // projector: svd — one SVD per projector
   std::vector<WeightedNullSpace> level_projectors_;  // [k] for level k ≥ 1: rows of levels < k
   WeightedNullSpace internal_projector_;
   std::vector<Vector6> wrench_ff_;  // per frame: K∘e + B∘V_d (+ mechanism part)

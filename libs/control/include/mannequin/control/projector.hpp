@@ -66,6 +66,42 @@ class WeightedNullSpace {
   VectorX r_;        // (rank ≤ rows) for the SVD path
 };
 
+/// The null-space projectors of every priority prefix of one task Jacobian from ONE factorisation.
+/// J (rows × n) has its rows in priority order; G = J W⁻¹ Jᵀ. G = L D Lᵀ without pivoting (L unit lower
+/// triangular): the factor of G's leading m × m block is then the leading part of G's, so the level
+/// projectors (the rows of the levels above, 2.78–2.80) and the internal projector (all rows, 2.25)
+/// share it. Semidefinite: row k's pivot d_k is the W⁻¹-norm² of the part of row k that the rows
+/// before it do not explain (Gram–Schmidt in the W⁻¹ metric); when d_k ≤ rank_tolerance · max_{j ≤ k}
+/// G_jj the row depends on the rows before it and is dropped (d_k = 0, column k of L = 0). With Q
+/// the orthogonalised rows (row k: what rows < k do not explain of J's row k; 0 when dropped), J = L Q,
+/// and Jᵀ L⁻ᵀ D⁺ L⁻¹ J W⁻¹ projects onto their span = J's row space, so Πᵀ g = g − Jᵀ L⁻ᵀ D⁺ L⁻¹ J W⁻¹ g is the projector of the file
+/// comment (L⁻ᵀ D⁺ L⁻¹ is a {1}-inverse of the thresholded G). A drop decision depends on rows ≤ k
+/// only, so it is the same for every prefix. m³/6 multiply–adds for the whole G, no allocation after
+/// construction (tests/control/projector_test.cpp: against kLdlt and kSvd, prefixes, rank deficiency).
+class PriorityGramFactor {
+ public:
+  PriorityGramFactor() = default;
+  /// \param rows task rows (may be 0), \param n joint velocities, \param rank_tolerance in (0, 1).
+  PriorityGramFactor(int rows, int n, double rank_tolerance);
+  /// Factorises G (rows × rows, lower triangle read).
+  void compute(const Eigen::Ref<const MatrixX>& G);
+  /// out = Πᵀ g for the task made of the first m rows of J (the J whose Gram was factorised; w_inv
+  /// the diagonal of W⁻¹). out may alias g. m = 0: out = g.
+  void projectTorque(const Eigen::Ref<const MatrixX>& J, const VectorX& w_inv, int m, const VectorX& g, VectorX& out);
+  /// Rows kept (independent) among the first m.
+  int rank(int m) const;
+  int rows() const { return rows_; }
+
+ private:
+  int rows_ = 0, n_ = 0;
+  double tol_ = 1e-8;
+  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> L_;  // strictly lower part used
+  VectorX d_;     // (rows) pivots, 0 for dropped rows
+  VectorX v_;     // (rows) L_kp d_p of the row being factorised
+  VectorX y_;     // (rows)
+  VectorX t_;     // (n)
+};
+
 /// Royer's augmented impedance (2.29–2.42) with K = b_a: N a basis of ker(J) (n × (n−r)) and the
 /// internal Jacobian J_int = (Nᵀ K N)⁻¹ Nᵀ K (2.39). Then Π = N J_int (2.36) equals the weighted
 /// projector above, and J b_a⁻¹ J_intᵀ = 0 (the off-diagonal block of 2.42 vanishes): the
