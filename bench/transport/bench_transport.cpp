@@ -12,7 +12,8 @@
 //   the publisher's context with 1 or 2 ZeroMQ I/O threads (a service's --io-threads): messages/s delivered
 //   to every subscriber and the CPU time of the publisher's ZeroMQ threads per message (in all and in the
 //   busiest one), and the one-way latency (p50, p99, max) of real WorldStates published at 1 kHz, from the
-//   publisher's send time to each subscriber's reception (one clock: same host).
+//   publisher's send time to each subscriber's reception (one clock: same host);
+// - VethThroughputSize8/curve:0|1/bytes:64|1024|16384: the throughput case with payloads of those sizes.
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <sched.h>
@@ -389,9 +390,8 @@ double threadsCpuSeconds(const std::vector<int>& tids) {
   return s;
 }
 
-void VethThroughput8(benchmark::State& state) {
-  const bool curve = state.range(0) == 1;
-  const int io_threads = static_cast<int>(state.range(1));
+/// `payload` as fast as the publisher queues it (one message per iteration) to 8 subscribers across a veth pair.
+void vethThroughput(benchmark::State& state, bool curve, int io_threads, const std::string& payload) {
   VethPair veth;
   if (!veth.error().empty()) {
     state.SkipWithError(("skipped: " + veth.error()).c_str());
@@ -400,7 +400,6 @@ void VethThroughput8(benchmark::State& state) {
     return;
   }
   const VethKeys keys(curve);
-  const std::string payload = worldPayload();
   std::vector<std::atomic<std::uint64_t>> counts(VethSubscribers::kCount);
   const std::string endpoint = "tcp://" + std::string(VethPair::kAddressA) + ":5700";
   InNetns in(veth.a());  // the publisher (this thread, its context's I/O thread) in namespace a
@@ -452,6 +451,15 @@ void VethThroughput8(benchmark::State& state) {
   }
   state.SetLabel(std::string(curve ? "veth tcp, CURVE" : "veth tcp, plaintext") + ", publisher io_threads " + std::to_string(io_threads));
 }
+
+void VethThroughput8(benchmark::State& state) {
+  vethThroughput(state, state.range(0) == 1, static_cast<int>(state.range(1)), worldPayload());
+}
+/// The same with a payload of `bytes` (not a WorldState: the subscribers do not parse it), 1 I/O thread.
+void VethThroughputSize8(benchmark::State& state) {
+  vethThroughput(state, state.range(0) == 1, 1, std::string(static_cast<std::size_t>(state.range(1)), 'x'));
+}
+BENCHMARK(VethThroughputSize8)->ArgNames({"curve", "bytes"})->ArgsProduct({{0, 1}, {64, 1024, 16384}})->Iterations(20000)->UseRealTime()->Unit(benchmark::kMicrosecond);
 BENCHMARK(VethThroughput8)->ArgNames({"curve", "io_threads"})->ArgsProduct({{0, 1}, {1, 2}})->Iterations(20000)->UseRealTime()->Unit(benchmark::kMicrosecond);
 
 void VethLatency8(benchmark::State& state) {
