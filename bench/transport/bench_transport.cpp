@@ -6,11 +6,14 @@
 // - MocapToWorld: a live sim service in-process (1 ms step, sim.world published at the first step after
 //   each new mocap frame), 10 000 MocapFrames at 1 kHz: latency from a frame's publication to the
 //   reception of the first WorldState computed from it (p50, p99, max, in µs);
-// - VethThroughput8/curve:0|1 and VethLatency8/curve:0|1: sim.world over tcp across a veth pair, the
-//   publisher in one network namespace and 8 subscribers in another (made by the benchmark with `ip`,
-//   deleted after; needs root: skipped with the reason otherwise), plaintext and CURVE: messages/s
-//   delivered to every subscriber, and the one-way latency (p50, p99, max) of real WorldStates published
-//   at 1 kHz, from the publisher's send time to each subscriber's reception (one clock: same host).
+// - VethThroughput8/curve:0|1/io_threads:1|2 and VethLatency8/curve:0|1/io_threads:1|2: sim.world over tcp
+//   across a veth pair, the publisher in one network namespace and 8 subscribers in another (made by the
+//   benchmark with `ip`, deleted after; needs root: skipped with the reason otherwise), plaintext and CURVE,
+//   the publisher's context with 1 or 2 ZeroMQ I/O threads (a service's --io-threads): messages/s delivered
+//   to every subscriber and the CPU time of the publisher's ZeroMQ threads per message (in all and in the
+//   busiest one), and the one-way latency (p50, p99, max) of real WorldStates published at 1 kHz, from the
+//   publisher's send time to each subscriber's reception (one clock: same host);
+// - VethThroughputSize8/curve:0|1/bytes:64|1024|16384: the throughput case with payloads of those sizes.
 #include <benchmark/benchmark.h>
 #include <fcntl.h>
 #include <sched.h>
@@ -22,8 +25,11 @@
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <iterator>
 #include <functional>
 #include <optional>
+#include <sstream>
 #include <thread>
 
 #include "bench_main.hpp"
@@ -355,8 +361,37 @@ class VethSubscribers {
   std::vector<std::thread> threads_;
 };
 
-void VethThroughput8(benchmark::State& state) {
-  const bool curve = state.range(0) == 1;
+/// The ids of this process's threads (/proc/self/task).
+std::vector<int> threadIds() {
+  std::vector<int> ids;
+  for (const auto& e : std::filesystem::directory_iterator("/proc/self/task")) ids.push_back(std::stoi(e.path().filename().string()));
+  std::sort(ids.begin(), ids.end());
+  return ids;
+}
+
+/// CPU time (user + system, s) of the given threads of this process (/proc/self/task/TID/stat).
+double threadsCpuSeconds(const std::vector<int>& tids) {
+  double s = 0;
+  for (const int tid : tids) {
+    std::ifstream in("/proc/self/task/" + std::to_string(tid) + "/stat");
+    std::string line;
+    std::getline(in, line);
+    const auto close = line.rfind(')');
+    if (close == std::string::npos) continue;
+    std::istringstream rest(line.substr(close + 2));
+    std::string field;
+    unsigned long long utime = 0, stime = 0;
+    for (int k = 3; k <= 15 && rest >> field; ++k) {  // fields 14, 15: utime, stime (clock ticks)
+      if (k == 14) utime = std::stoull(field);
+      if (k == 15) stime = std::stoull(field);
+    }
+    s += static_cast<double>(utime + stime) / static_cast<double>(::sysconf(_SC_CLK_TCK));
+  }
+  return s;
+}
+
+/// `payload` as fast as the publisher queues it (one message per iteration) to 8 subscribers across a veth pair.
+void vethThroughput(benchmark::State& state, bool curve, int io_threads, const std::string& payload) {
   VethPair veth;
   if (!veth.error().empty()) {
     state.SkipWithError(("skipped: " + veth.error()).c_str());
@@ -365,20 +400,26 @@ void VethThroughput8(benchmark::State& state) {
     return;
   }
   const VethKeys keys(curve);
-  const std::string payload = worldPayload();
   std::vector<std::atomic<std::uint64_t>> counts(VethSubscribers::kCount);
   const std::string endpoint = "tcp://" + std::string(VethPair::kAddressA) + ":5700";
   InNetns in(veth.a());  // the publisher (this thread, its context's I/O thread) in namespace a
   {
-    zmq::context_t ctx(1);
+    zmq::context_t ctx(io_threads);
+    const std::vector<int> before = threadIds();
     transport::PublisherOptions po{"sim", {endpoint}};
     po.send_hwm = 100000;
     po.curve = keys.server;
     transport::Publisher pub(ctx, po);
+    // the publisher's context's threads (its I/O threads, the reaper, the ZAP handler with CURVE): started
+    // by its first socket, before any subscriber's
+    std::vector<int> pub_threads;
+    std::ranges::set_difference(threadIds(), before, std::back_inserter(pub_threads));
     VethSubscribers subs(veth.b(), endpoint, keys.client,
                          [&](int i, std::string_view, const transport::Received&) { ++counts[static_cast<std::size_t>(i)]; });
     waitSubscribed(pub, VethSubscribers::kCount);
     std::uint64_t sent = 0;
+    std::vector<double> cpu0;
+    for (const int tid : pub_threads) cpu0.push_back(threadsCpuSeconds({tid}));
     const std::int64_t t0 = transport::steadyNs();
     for (auto _ : state) {
       pub.publishRaw("sim.world", payload);
@@ -394,16 +435,36 @@ void VethThroughput8(benchmark::State& state) {
       std::this_thread::sleep_for(std::chrono::milliseconds(1));
     }
     const double seconds = static_cast<double>(transport::steadyNs() - t0) * 1e-9;
+    // what the sim's host pays: CPU of the publisher's ZeroMQ threads per message (all 8 copies), in all
+    // and in the busiest one (with free cores, the publisher cannot go faster than that thread)
+    double total = 0, busiest = 0;
+    for (std::size_t k = 0; k < pub_threads.size(); ++k) {
+      const double used = threadsCpuSeconds({pub_threads[k]}) - cpu0[k];
+      total += used;
+      busiest = std::max(busiest, used);
+    }
+    state.counters["pub_io_cpu_us_per_msg"] = total * 1e6 / static_cast<double>(sent);
+    state.counters["pub_busiest_thread_cpu_us_per_msg"] = busiest * 1e6 / static_cast<double>(sent);
     state.counters["msg_per_s_per_subscriber"] = static_cast<double>(minCount()) / seconds;
     state.counters["delivered_fraction"] = static_cast<double>(minCount()) / static_cast<double>(sent);
     state.counters["payload_bytes"] = static_cast<double>(payload.size());
   }
-  state.SetLabel(curve ? "veth tcp, CURVE" : "veth tcp, plaintext");
+  state.SetLabel(std::string(curve ? "veth tcp, CURVE" : "veth tcp, plaintext") + ", publisher io_threads " + std::to_string(io_threads));
 }
-BENCHMARK(VethThroughput8)->ArgName("curve")->Arg(0)->Arg(1)->Iterations(20000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+
+void VethThroughput8(benchmark::State& state) {
+  vethThroughput(state, state.range(0) == 1, static_cast<int>(state.range(1)), worldPayload());
+}
+/// The same with a payload of `bytes` (not a WorldState: the subscribers do not parse it), 1 I/O thread.
+void VethThroughputSize8(benchmark::State& state) {
+  vethThroughput(state, state.range(0) == 1, 1, std::string(static_cast<std::size_t>(state.range(1)), 'x'));
+}
+BENCHMARK(VethThroughputSize8)->ArgNames({"curve", "bytes"})->ArgsProduct({{0, 1}, {64, 1024, 16384}})->Iterations(20000)->UseRealTime()->Unit(benchmark::kMicrosecond);
+BENCHMARK(VethThroughput8)->ArgNames({"curve", "io_threads"})->ArgsProduct({{0, 1}, {1, 2}})->Iterations(20000)->UseRealTime()->Unit(benchmark::kMicrosecond);
 
 void VethLatency8(benchmark::State& state) {
   const bool curve = state.range(0) == 1;
+  const int io_threads = static_cast<int>(state.range(1));
   const int messages = 2000;  // at 1 kHz
   VethPair veth;
   if (!veth.error().empty()) {
@@ -418,7 +479,7 @@ void VethLatency8(benchmark::State& state) {
   for (auto _ : state) {
     std::vector<std::vector<double>> latency_us(VethSubscribers::kCount);
     for (auto& l : latency_us) l.reserve(messages);
-    zmq::context_t ctx(1);
+    zmq::context_t ctx(io_threads);
     transport::PublisherOptions po{"sim", {endpoint}};
     po.curve = keys.server;
     transport::Publisher pub(ctx, po);
@@ -456,9 +517,9 @@ void VethLatency8(benchmark::State& state) {
     state.counters["p99_us"] = pct(0.99);
     state.counters["max_us"] = all.empty() ? -1.0 : all.back();
   }
-  state.SetLabel(curve ? "veth tcp, CURVE, 1 kHz" : "veth tcp, plaintext, 1 kHz");
+  state.SetLabel(std::string(curve ? "veth tcp, CURVE, 1 kHz" : "veth tcp, plaintext, 1 kHz") + ", publisher io_threads " + std::to_string(io_threads));
 }
-BENCHMARK(VethLatency8)->ArgName("curve")->Arg(0)->Arg(1)->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(VethLatency8)->ArgNames({"curve", "io_threads"})->ArgsProduct({{0, 1}, {1, 2}})->Iterations(1)->UseRealTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 

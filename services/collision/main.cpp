@@ -10,7 +10,7 @@ int main(int argc, char** argv) {
   return cli.run(argc, argv, [&](const std::atomic<bool>& stop) {
     const core::ConfigNode config = service::loadConfig(cli.options);
     const collisionservice::CollisionServiceConfig c = collisionservice::parseCollisionConfig(config);
-    zmq::context_t context;
+    zmq::context_t context(cli.options.io_threads);
     collisionservice::CollisionService service(c, service::resolveEndpoints(cli.options, config, "collision"), context,
                                                cli.options.heartbeat_period);
     return service.run(stop, cli.options.duration);

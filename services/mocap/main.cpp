@@ -34,7 +34,7 @@ int main(int argc, char** argv) {
     config.allowOnly({"name", "publish", "security", "source", "bvh", "c3d", "synthetic", "dtrack2"});
     const service::Endpoints ep = service::resolveEndpoints(common, config, "mocap");
     std::unique_ptr<mocap::Source> source = mocap::makeSource(config);
-    zmq::context_t context;
+    zmq::context_t context(common.io_threads);
     transport::Publisher pub(context, service::publisherOptions(ep));
     transport::HealthReporter health(pub, ep.name, nullptr, common.heartbeat_period);
     spdlog::info("{}: {} → mocap.frame on {}", ep.name, source->describe(), fmt::join(pub.boundEndpoints(), ", "));

@@ -41,7 +41,7 @@ int main(int argc, char** argv) {
     config.checkpoint = checkpoint;
     config.checkpoint_period = checkpoint_period;
     config.resume = resume;
-    zmq::context_t context;
+    zmq::context_t context(common.io_threads);
     simservice::SimService service(config, context, common.heartbeat_period);
     return service.run(stop, common.duration);
   });

@@ -4,17 +4,26 @@
 // --summary-json: restarts 0), and the gap is reported — in sim.world (the mocap frame's age, the sim's
 // mocap_glitches.stream_gaps), in the station's status lines (services late, then up again) and in the
 // station's recording of sim.world (the receive gap, then states again). Packet loss: netem, else an nftables
-// rule (the kernel here has no sch_netem); skipped when neither can. Root only: skipped otherwise.
+// rule (the kernel here has no sch_netem); skipped when neither can. Root only: skipped otherwise. Between the
+// faults the test waits on conditions (a live CURVE subscriber to sim.world on the station, the recorder's
+// progress), each with a deadline that fails naming what did not come; the only sleeps are the 2 s outages.
+#include <fcntl.h>
 #include <gtest/gtest.h>
+#include <sched.h>
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
-#include <limits>
+#include <atomic>
+#include <cerrno>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <limits>
+#include <mutex>
 #include <string>
 #include <thread>
 #include <vector>
@@ -23,6 +32,8 @@
 #include "../common/netns_room.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
 #include "mannequin/transport/security.hpp"
+#include "mannequin/transport/subscriber.hpp"
+#include "mannequin/transport/topics.hpp"
 
 using namespace mannequin;
 using namespace mannequin::testutil::netns;
@@ -77,6 +88,87 @@ std::vector<Recorded> recorded(const fs::path& mcap) {
   return out;
 }
 
+// sim.world as the station receives it, live: a CURVE subscriber with the operator's key in the station's
+// namespace (its own thread and context, so its ZeroMQ I/O thread is there too). The test waits on what it
+// sees instead of sleeping through a measurement window.
+class StationWatch {
+ public:
+  StationWatch(const std::string& ns, const fs::path& keys) {
+    transport::CurveClientOptions curve;
+    curve.public_key = transport::readKeyFile((keys / "operator.key").string(), false);
+    curve.secret_key = transport::readKeyFile((keys / "operator.key_secret").string(), true);
+    curve.server_public_key = transport::readKeyFile((keys / "sim.key").string(), false);
+    thread_ = std::thread([this, ns, curve] {
+      try {
+        const int target = ::open(("/run/netns/" + ns).c_str(), O_RDONLY | O_CLOEXEC);
+        if (target < 0) throw std::runtime_error("cannot open /run/netns/" + ns + ": " + std::strerror(errno));
+        const int entered = ::setns(target, CLONE_NEWNET);  // this thread only; it ends in the namespace
+        const int err = errno;
+        ::close(target);
+        if (entered != 0) throw std::runtime_error("cannot enter network namespace " + ns + ": " + std::strerror(err));
+        zmq::context_t context(1);
+        transport::Subscriber sub(context, {"fault-watch", {"tcp://10.77.0.2:5603"}, 1000, 10000, curve});
+        sub.subscribe(transport::topics::kSimWorld, [this](const v1::WorldState& w, const transport::Received&) {
+          const std::lock_guard lock(mutex_);
+          ++count_;
+          last_ = w;
+        });
+        while (!stop_.load()) sub.poll(std::chrono::milliseconds(20));
+      } catch (const std::exception& e) {
+        const std::lock_guard lock(mutex_);
+        error_ = e.what();
+      }
+    });
+  }
+  ~StationWatch() {
+    stop_ = true;
+    thread_.join();
+  }
+  StationWatch(const StationWatch&) = delete;
+  StationWatch& operator=(const StationWatch&) = delete;
+  /// Waits until done(states received, the last one) holds; false at the deadline or when the watch failed.
+  bool waitFor(const std::function<bool(std::uint64_t, const v1::WorldState&)>& done, std::chrono::seconds timeout) {
+    const auto until = std::chrono::steady_clock::now() + timeout;
+    for (;;) {
+      {
+        const std::lock_guard lock(mutex_);
+        if (!error_.empty()) return false;
+        if (done(count_, last_)) return true;
+      }
+      if (std::chrono::steady_clock::now() >= until) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+  }
+  /// States received, the last one's sequence, its stream gaps and mocap age, any error: for failure messages.
+  std::string status() {
+    const std::lock_guard lock(mutex_);
+    return "the station's watch received " + std::to_string(count_) + " sim.world; the last: sequence " +
+           std::to_string(last_.header().sequence()) + ", stream_gaps " + std::to_string(last_.mocap_glitches().stream_gaps()) +
+           ", mocap frame age " + std::to_string(static_cast<double>(last_.header().send_time_ns() - last_.mocap().send_time_ns()) * 1e-9) +
+           " s" + (error_.empty() ? "" : "; error: " + error_);
+  }
+  std::uint64_t count() {
+    const std::lock_guard lock(mutex_);
+    return count_;
+  }
+
+ private:
+  std::mutex mutex_;
+  std::uint64_t count_ = 0;
+  v1::WorldState last_;
+  std::string error_;
+  std::atomic<bool> stop_{false};
+  std::thread thread_;
+};
+
+// The number of messages in the last progress line of mannequin-record's log ("N s: M messages, ..."); 0 if none.
+std::uint64_t recordedCount(const std::string& log) {
+  const std::size_t at = log.rfind(" messages, ");
+  if (at == std::string::npos) return 0;
+  const std::size_t from = log.rfind(": ", at);
+  return from == std::string::npos ? 0 : std::stoull(log.substr(from + 2, at - from - 2));
+}
+
 // The room with its launchers started and every one showing 3/3 up; "" when ready, else why not (or
 // "skip: ..." when the room cannot be built here).
 class FaultRoom {
@@ -102,12 +194,16 @@ class FaultRoom {
     return {};
   }
   static std::string bin() { return MANNEQUIN_BIN_DIR; }
-  pid_t record(const fs::path& out, int seconds) {
+  /// mannequin-record on the station (sim.world) for `seconds`, logging its count every `progress` s (0: never).
+  pid_t record(const fs::path& out, int seconds, const std::string& progress = "0") {
     return room_.start("station",
                        {bin() + "/mannequin-record", (dir_ / "room.yaml").string(), "--client-key", (dir_ / "keys" / "operator.key_secret").string(),
-                        "--topics", "sim.world", "--duration", std::to_string(seconds), "--progress", "0", "--out", out.string()},
+                        "--topics", "sim.world", "--duration", std::to_string(seconds), "--progress", progress, "--out", out.string()},
                        dir_ / "record.log");
   }
+  std::string ns(const std::string& host) const { return room_.ns(host); }
+  /// SIGTERM to a process started here; its exit code.
+  int stop(pid_t pid, const std::string& what) { return room_.stop(pid, what); }
   /// `ip -n NS ARGS` for the sim's namespace (the bridge); its exit code, output in fault-ip.log.
   int inSim(const std::vector<std::string>& args) {
     std::vector<std::string> full{"-n", room_.ns("sim")};
@@ -185,25 +281,52 @@ TEST(NetnsFaults, ALinkDownForTwoSecondsIsReportedAndTheRoomRecoversWithoutARest
     FAIL() << e;
   }
   const fs::path rec = dir / "station.mcap";
-  const pid_t recorder = room.record(rec, 14);
+  // recording until the test has what it measures (SIGTERM below); 90 s only bounds it
+  const pid_t recorder = room.record(rec, 90, "0.2");
   ASSERT_GT(recorder, 0);
   using namespace std::chrono_literals;
   const auto wall = [] { return std::chrono::duration_cast<std::chrono::nanoseconds>(std::chrono::system_clock::now().time_since_epoch()).count(); };
-  // the faults last 2 s by design (these sleeps are the faults, not waits for a condition)
-  std::this_thread::sleep_for(3s);
+  const auto age = [](const v1::WorldState& w) { return static_cast<double>(w.header().send_time_ns() - w.mocap().send_time_ns()) * 1e-9; };
+  StationWatch watch(room.ns("station"), dir / "keys");
+  // before the faults: the recorder has sim.world, and 2 s of it (120 states at 60 Hz) reached the station
+  // (the recording before the outage, whose fastest joint is the reference)
+  ASSERT_TRUE(waitForText({dir / "record.log"}, "recording 'sim.world'", 30s)) << "the recorder got no sim.world in 30 s\n" << readFile(dir / "record.log");
+  const std::uint64_t at_start = watch.count();
+  ASSERT_TRUE(watch.waitFor([&](std::uint64_t n, const v1::WorldState&) { return n >= at_start + 120; }, 20s))
+      << "120 sim.world did not reach the station in 20 s: " << watch.status();
+  std::uint64_t gaps_at_down = 0;
+  watch.waitFor([&](std::uint64_t, const v1::WorldState& w) { return gaps_at_down = w.mocap_glitches().stream_gaps(), true; }, 0s);
+  // the faults last 2 s by design (these two sleeps are the faults, not waits for a condition)
   const std::int64_t mocap_down = wall();
   ASSERT_EQ(room.inSim({"link", "set", "to_mocap", "down"}), 0) << room.ipLog();
   std::this_thread::sleep_for(2s);
   ASSERT_EQ(room.inSim({"link", "set", "to_mocap", "up"}), 0) << room.ipLog();
   const std::int64_t mocap_up = wall();
-  std::this_thread::sleep_for(3s);
+  // after it: the sim has reported the gap, the frames are fresh again, and the 3 s after the link came back
+  // (where the check for a jump looks) have reached the station
+  ASSERT_TRUE(watch.waitFor(
+      [&](std::uint64_t, const v1::WorldState& w) {
+        return w.header().send_time_ns() >= mocap_up + 3'000'000'000 && w.mocap_glitches().stream_gaps() > gaps_at_down && age(w) < 0.1;
+      },
+      30s))
+      << "no stream gap reported with fresh mocap frames again at the station within 30 s of the mocap link coming back: " << watch.status();
   const std::size_t station_log_before = readFile(room.logs[2]).size();
+  const std::uint64_t recorded_before = recordedCount(readFile(dir / "record.log"));
   const std::int64_t station_down = wall();
   ASSERT_EQ(room.inSim({"link", "set", "to_station", "down"}), 0) << room.ipLog();
   std::this_thread::sleep_for(2s);
   ASSERT_EQ(room.inSim({"link", "set", "to_station", "up"}), 0) << room.ipLog();
   const std::int64_t station_up = wall();
-  EXPECT_EQ(room.wait(recorder, "mannequin-record on the station", 40s), 0) << readFile(dir / "record.log");
+  // the station receives again: the watch has a state sent 1 s after the link came back, and the recorder's
+  // count has gone past what it had before the outage by 60 (1 s at 60 Hz: the burst of what tcp kept)
+  ASSERT_TRUE(watch.waitFor([&](std::uint64_t, const v1::WorldState& w) { return w.header().send_time_ns() >= station_up + 1'000'000'000; }, 30s))
+      << "no sim.world sent after the station's link came back reached the station within 30 s: " << watch.status();
+  const auto recorder_caught_up = [&] { return recordedCount(readFile(dir / "record.log")) >= recorded_before + 60; };
+  for (const auto until = std::chrono::steady_clock::now() + 30s; !recorder_caught_up() && std::chrono::steady_clock::now() < until;)
+    std::this_thread::sleep_for(50ms);
+  ASSERT_TRUE(recorder_caught_up()) << "the recorder did not receive again within 30 s of the station's link coming back (" << recorded_before
+                                    << " messages before)\n" << readFile(dir / "record.log");
+  EXPECT_EQ(room.stop(recorder, "mannequin-record on the station"), 0) << readFile(dir / "record.log");
   // the station's launcher saw the room late, then up again
   EXPECT_TRUE(waitForText({room.logs[2]}, "| 3/3 up | mocap", 10s));
   const std::string station_after = readFile(room.logs[2]).substr(station_log_before);

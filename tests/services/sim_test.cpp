@@ -717,6 +717,12 @@ TEST(SimTool, ScenarioOptionReplacesTheConfigsScenario) {
   const testutil::ToolResult missing = testutil::runTool(common + " --scenario configs/scenarios/nonexistent.yaml", 60);
   EXPECT_EQ(missing.exit_code, 2) << missing.err;
   EXPECT_NE(missing.err.find("nonexistent.yaml"), std::string::npos) << missing.err;
+  // --io-threads (a service's ZeroMQ I/O threads): 2 runs; 0 is a bad command line naming the option
+  const testutil::ToolResult two = testutil::runTool(common + " --io-threads 2", 60);
+  EXPECT_EQ(two.exit_code, 0) << two.err;
+  const testutil::ToolResult zero = testutil::runTool(common + " --io-threads 0", 60);
+  EXPECT_EQ(zero.exit_code, 2) << zero.err;
+  EXPECT_NE(zero.err.find("--io-threads"), std::string::npos) << zero.err;
 }
 
 // Offline from a recording (--mocap F.mcap, as mannequin-batch takes it): the ball demonstration's scripted

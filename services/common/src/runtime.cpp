@@ -23,6 +23,11 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
   app.add_option("--heartbeat-period", o.heartbeat_period, "seconds between heartbeats")
       ->capture_default_str()
       ->check(CLI::Range(0.01, 60.0));
+  app.add_option("--io-threads", o.io_threads,
+                 "ZeroMQ I/O threads (ZMQ_IO_THREADS); more than 1 spreads the CURVE encryption for many subscribers over "
+                 "cores (a sim host with cores to spare); 1 on a small single host")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 16));
 }
 
 Cli::Cli(std::string description) : app(std::move(description)) { addCommonOptions(app, options); }

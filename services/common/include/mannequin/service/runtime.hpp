@@ -30,6 +30,9 @@ struct CommonOptions {
   std::string log_level = "info";     ///< --log-level
   double heartbeat_period = 0.5;      ///< --heartbeat-period S
   std::string security;               ///< --security FILE: its `security` section replaces the config's
+  /// --io-threads N: ZeroMQ I/O threads of the service's context (ZMQ_IO_THREADS). 1 suits a single host;
+  /// a publisher with many CURVE subscribers spreads their encryption over N threads (docs/cluster.md).
+  int io_threads = 1;
 };
 
 /// Adds the common options to a CLI11 app (--config is required).
