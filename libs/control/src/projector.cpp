@@ -141,26 +141,27 @@ void PriorityGramFactor::compute(const Eigen::Ref<const MatrixX>& G) {
   if (G.rows() != rows_ || G.cols() != rows_)
     throw std::invalid_argument("PriorityGramFactor::compute: G is " + std::to_string(G.rows()) + "x" +
                                 std::to_string(G.cols()) + ", expected " + std::to_string(rows_) + "x" + std::to_string(rows_));
+  // right-looking (outer-product) LDLᵀ on the lower triangle, in place in L_: at step k, column k
+  // below the diagonal holds the Schur complement's column; it becomes L's column k (÷ d_k) and is
+  // removed from the trailing block (independent column updates: no dependency chain through the
+  // divisions, unlike the row-by-row form)
+  L_.triangularView<Eigen::Lower>() = G.triangularView<Eigen::Lower>();
   double gmax = 0.0;
   for (int k = 0; k < rows_; ++k) {
-    // row k of L: L_kj = (G_kj − Σ_{p<j} L_kp d_p L_jp) / d_j, then d_k = G_kk − Σ_{j<k} L_kj² d_j
-    double* Lk = L_.row(k).data();
-    double dk = G(k, k);
-    for (int j = 0; j < k; ++j) {
-      if (d_(j) > 0.0) {
-        const double* Lj = L_.row(j).data();
-        double s = G(k, j);
-        for (int p = 0; p < j; ++p) s -= v_(p) * Lj[p];
-        Lk[j] = s / d_(j);
-        v_(j) = Lk[j] * d_(j);
-        dk -= Lk[j] * v_(j);
-      } else {
-        Lk[j] = 0.0;
-        v_(j) = 0.0;
-      }
+    const double gkk = G(k, k);
+    if (std::isfinite(gkk)) gmax = std::max(gmax, gkk);
+    const double dk = L_(k, k);
+    const int r = rows_ - k - 1;
+    auto col = L_.col(k).tail(r);
+    if (!(std::isfinite(dk) && dk > tol_ * gmax)) {  // row k depends on the rows before it: dropped
+      d_(k) = 0.0;
+      col.setZero();
+      continue;
     }
-    if (std::isfinite(G(k, k))) gmax = std::max(gmax, G(k, k));
-    d_(k) = std::isfinite(dk) && dk > tol_ * gmax ? dk : 0.0;
+    d_(k) = dk;
+    v_.head(r) = col;  // the Schur column before scaling: A_jk
+    col /= dk;         // L_ik
+    for (int j = 0; j < r; ++j) L_.col(k + 1 + j).tail(r - j) -= v_(j) * col.tail(r - j);
   }
 }
 
@@ -172,22 +173,13 @@ void PriorityGramFactor::projectTorque(const Eigen::Ref<const MatrixX>& J, const
     if (&out != &g) out = g;
     return;
   }
-  // y = J_m W⁻¹ g; z = L⁻ᵀ D⁺ L⁻¹ y; out = g − J_mᵀ z
+  // y = J_m W⁻¹ g; z = L⁻ᵀ D⁺ L⁻¹ y (the leading m × m part of L); out = g − J_mᵀ z
   t_ = w_inv.cwiseProduct(g);
   auto y = y_.head(m);
   y.noalias() = J.topRows(m) * t_;
-  for (int k = 0; k < m; ++k) {
-    const double* Lk = L_.row(k).data();
-    double s = y(k);
-    for (int j = 0; j < k; ++j) s -= Lk[j] * y(j);
-    y(k) = s;
-  }
+  for (int k = 0; k + 1 < m; ++k) y.tail(m - k - 1) -= y(k) * L_.col(k).segment(k + 1, m - k - 1);
   for (int k = 0; k < m; ++k) y(k) = d_(k) > 0.0 ? y(k) / d_(k) : 0.0;
-  for (int k = m - 1; k > 0; --k) {
-    const double* Lk = L_.row(k).data();
-    const double zk = y(k);
-    for (int j = 0; j < k; ++j) y(j) -= Lk[j] * zk;
-  }
+  for (int k = m - 2; k >= 0; --k) y(k) -= L_.col(k).segment(k + 1, m - k - 1).dot(y.tail(m - k - 1));
   t_.noalias() = J.topRows(m).transpose() * y;
   out = g - t_;
 }

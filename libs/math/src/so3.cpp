@@ -35,8 +35,16 @@ Matrix3 expSO3(const Vector3& w) {
     a = std::sin(t) / t;
     b = (1.0 - std::cos(t)) / t2;
   }
-  const Matrix3 W = hat(w);
-  return Matrix3::Identity() + a * W + b * W * W;
+  // [ω]² = ω ωᵀ − θ² I: R = (1 − bθ²) I + a[ω] + b ω ωᵀ (no 3 × 3 product)
+  const double c = 1.0 - b * t2;
+  const double bx = b * w.x(), by = b * w.y(), bz = b * w.z();
+  const double ax = a * w.x(), ay = a * w.y(), az = a * w.z();
+  const double bxy = bx * w.y(), bxz = bx * w.z(), byz = by * w.z();
+  Matrix3 R;
+  R << c + bx * w.x(), bxy - az, bxz + ay,
+       bxy + az, c + by * w.y(), byz - ax,
+       bxz - ay, byz + ax, c + bz * w.z();
+  return R;
 }
 
 Vector3 logSO3(const Matrix3& R) {
@@ -96,8 +104,16 @@ Matrix3 rightJacobianSO3(const Vector3& w) {
 Matrix3 leftJacobianSO3(const Vector3& w) {
   double a, b;
   jacobianCoefficients(w, &a, &b);
-  const Matrix3 W = hat(w);
-  return Matrix3::Identity() + a * W + b * W * W;
+  // I + a[ω] + b[ω]² with [ω]² = ω ωᵀ − θ² I (no 3 × 3 product)
+  const double c = 1.0 - b * w.squaredNorm();
+  const double bx = b * w.x(), by = b * w.y(), bz = b * w.z();
+  const double ax = a * w.x(), ay = a * w.y(), az = a * w.z();
+  const double bxy = bx * w.y(), bxz = bx * w.z(), byz = by * w.z();
+  Matrix3 R;
+  R << c + bx * w.x(), bxy - az, bxz + ay,
+       bxy + az, c + by * w.y(), byz - ax,
+       bxz - ay, byz + ax, c + bz * w.z();
+  return R;
 }
 
 Matrix3 rightJacobianInverseSO3(const Vector3& w) {

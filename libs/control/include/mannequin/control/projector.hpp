@@ -95,9 +95,9 @@ class PriorityGramFactor {
  private:
   int rows_ = 0, n_ = 0;
   double tol_ = 1e-8;
-  Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor> L_;  // strictly lower part used
+  MatrixX L_;      // (rows × rows) L below the diagonal (the diagonal and above: scratch)
   VectorX d_;     // (rows) pivots, 0 for dropped rows
-  VectorX v_;     // (rows) L_kp d_p of the row being factorised
+  VectorX v_;     // (rows) the Schur column being eliminated
   VectorX y_;     // (rows)
   VectorX t_;     // (n)
 };
