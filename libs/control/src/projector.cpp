@@ -159,9 +159,21 @@ void PriorityGramFactor::compute(const Eigen::Ref<const MatrixX>& G) {
       continue;
     }
     d_(k) = dk;
-    v_.head(r) = col;  // the Schur column before scaling: A_jk
-    col /= dk;         // L_ik
-    for (int j = 0; j < r; ++j) L_.col(k + 1 + j).tail(r - j) -= v_(j) * col.tail(r - j);
+    const Eigen::Index ld = L_.outerStride();
+    double* lk = L_.data() + k * ld + k + 1;  // column k below the diagonal
+    double* v = v_.data();
+    const double inv = 1.0 / dk;
+    for (int i = 0; i < r; ++i) {
+      v[i] = lk[i];       // the Schur column before scaling: A_ik
+      lk[i] = v[i] * inv;  // L_ik
+    }
+    // trailing lower block: A_ij −= L_ik A_jk (i ≥ j), column by column (plain loops: vectorised axpys)
+    for (int j = 0; j < r; ++j) {
+      double* cj = L_.data() + (k + 1 + j) * ld + (k + 1 + j);
+      const double* li = lk + j;
+      const double vj = v[j];
+      for (int i = 0; i < r - j; ++i) cj[i] -= vj * li[i];
+    }
   }
 }
 
