@@ -36,13 +36,21 @@ SwingTwist swingTwist(const Matrix3d& R, const Vector3d& t, const Vector3d& fall
     f = (sin_t - th * cos_t) / (sin_t * sin_t * sin_t);
   }
   st.swing = sin_t > 1e-12 || th < 1e-3 ? Vector3d(g * w) : Vector3d(th * st.swing_dir);
-  // the twist: R_t = R_sᵀ R, signed angle about t
-  const Matrix3d Rt = math::expSO3(st.swing).transpose() * R;
+  // the twist: R_t = R_sᵀ R, signed angle about t. R_sᵀ is the geodesic rotation taking z1 back to t:
+  // without trigonometry, I + [v] + [v]²/(1 + c) with v = z1 × t = −w, c = t·z1 (Rodrigues with
+  // sin θ_s = |v|, 1 − cos θ_s = 1 − c); near θ_s = π (1 + c → 0) from exp(−[s]) instead
+  Matrix3d Rt;
+  if (cos_t > -0.5) {
+    const Matrix3d V = math::hat(-w);
+    Rt = (Matrix3d::Identity() + V + (V * V) / (1.0 + cos_t)) * R;
+  } else {
+    Rt = math::expSO3(st.swing).transpose() * R;
+  }
   st.twist = std::atan2(t.dot(math::vee(Rt)), 0.5 * (Rt.trace() - 1.0));
   st.singular = th > kSwingSingular;
   if (!jacobians) return st;
   // dθ_s/dω = (t × Rᵀ e_θ)ᵀ, e_θ the direction in which z1 moves when θ_s grows
-  const Vector3d e_th = -std::sin(th) * t + std::cos(th) * st.swing_dir.cross(t);
+  const Vector3d e_th = -sin_t * t + cos_t * st.swing_dir.cross(t);  // sin θ_s = |t × z1|, cos θ_s = t·z1
   st.swing_angle_jacobian = t.cross(R.transpose() * e_th).transpose();
   if (st.singular) return st;
   const Matrix3d T = math::hat(t);
