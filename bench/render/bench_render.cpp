@@ -137,6 +137,23 @@ void BM_HeadlessDrawOnly(benchmark::State& state) {
 }
 BENCHMARK(BM_HeadlessDrawOnly)->Args({1280, 720})->Unit(benchmark::kMillisecond)->UseRealTime();
 
+// writePng of the benchmark's 1280×720 frame to a temporary file: arg 0 PngSpeed::kSmall, 1 kFast
+// (a live headless node writes its frame with kFast before it counts as swapped). Counter: bytes written.
+void BM_WritePng(benchmark::State& state) {
+  const render::PngSpeed speed = state.range(0) != 0 ? render::PngSpeed::kFast : render::PngSpeed::kSmall;
+  render::Image img;
+  {
+    Fixture f(1280, 720);
+    f.renderer->draw(render::buildScene(f.ws, f.assets, f.view.style), f.view.camera(1280, 720), 1280, 720, f.view.background);
+    img = f.ctx.read();
+  }
+  const std::string path = (std::filesystem::temp_directory_path() / ("bench-render-" + std::to_string(::getpid()) + ".png")).string();
+  for (auto _ : state) render::writePng(path, img, speed);
+  state.counters["bytes"] = static_cast<double>(std::filesystem::file_size(path));
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_WritePng)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
+
 // buildScene alone (no GL): the CPU cost of the scene model per frame.
 void BM_BuildScene(benchmark::State& state) {
   Fixture f(16, 16);
