@@ -39,6 +39,20 @@ void main() {
 }
 )";
 
+// Flat surfaces (planes): one normal, so the headlight's shading is one colour, computed on the CPU with
+// kFragment's formula; llvmpipe then has no varyings to interpolate over the floor's many pixels.
+const char* kFlatVertex = R"(#version 330 core
+layout(location = 0) in vec3 a_pos;
+uniform mat4 u_mvp;
+void main() { gl_Position = u_mvp * vec4(a_pos, 1.0); }
+)";
+
+const char* kFlatFragment = R"(#version 330 core
+uniform vec4 u_colour;
+out vec4 frag;
+void main() { frag = u_colour; }
+)";
+
 unsigned compile(GLenum type, const char* src) {
   const GLuint s = glCreateShader(type);
   glShaderSource(s, 1, &src, nullptr);
@@ -198,16 +212,23 @@ Renderer::Renderer() {
   glGetIntegerv(GL_MINOR_VERSION, &minor);
   if (major * 10 + minor < 33)
     throw RenderError("OpenGL 3.3 core is needed; the current context is " + describeContext());
-  const unsigned vs = compile(GL_VERTEX_SHADER, kVertex), fs = compile(GL_FRAGMENT_SHADER, kFragment);
-  program_ = glCreateProgram();
-  glAttachShader(program_, vs);
-  glAttachShader(program_, fs);
-  glLinkProgram(program_);
-  glDeleteShader(vs);
-  glDeleteShader(fs);
-  GLint ok = 0;
-  glGetProgramiv(program_, GL_LINK_STATUS, &ok);
-  if (!ok) throw RenderError("shader link failed");
+  const auto link = [](const char* vertex, const char* fragment) {
+    const unsigned vs = compile(GL_VERTEX_SHADER, vertex), fs = compile(GL_FRAGMENT_SHADER, fragment);
+    const unsigned program = glCreateProgram();
+    glAttachShader(program, vs);
+    glAttachShader(program, fs);
+    glLinkProgram(program);
+    glDeleteShader(vs);
+    glDeleteShader(fs);
+    GLint ok = 0;
+    glGetProgramiv(program, GL_LINK_STATUS, &ok);
+    if (!ok) throw RenderError("shader link failed");
+    return program;
+  };
+  program_ = link(kVertex, kFragment);
+  flat_program_ = link(kFlatVertex, kFlatFragment);
+  u_flat_mvp_ = glGetUniformLocation(flat_program_, "u_mvp");
+  u_flat_colour_ = glGetUniformLocation(flat_program_, "u_colour");
   u_mvp_ = glGetUniformLocation(program_, "u_mvp");
   u_normal_ = glGetUniformLocation(program_, "u_normal");
   u_colour_ = glGetUniformLocation(program_, "u_colour");
@@ -249,6 +270,7 @@ Renderer::~Renderer() {
   if (line_vbo_) glDeleteBuffers(1, &line_vbo_);
   if (line_vao_) glDeleteVertexArrays(1, &line_vao_);
   if (program_) glDeleteProgram(program_);
+  if (flat_program_) glDeleteProgram(flat_program_);
 }
 
 Renderer::Mesh Renderer::upload(const std::vector<float>& interleaved, const std::vector<unsigned>& indices) {
@@ -366,21 +388,35 @@ void Renderer::draw(const RenderScene& scene, const Camera& camera, int x, int y
   culling_ = false;
   mirrored_ = false;
   bound_vao_ = 0;
-  glUseProgram(program_);
   view_ = camera.view;
   proj_ = camera.projection;
   view_proj_ = camera.projection * camera.view;
   // pixels per unit of (x or y) / depth, whichever is finer: a sphere's tessellation follows its size on screen
   pixels_per_unit_ = std::max(std::abs(proj_(0, 0)) * 0.5 * width, std::abs(proj_(1, 1)) * 0.5 * height);
   const Eigen::Vector3f light = Eigen::Vector3f(0.3f, 0.5f, 1.0f).normalized();
-  glUniform3f(u_light_, light.x(), light.y(), light.z());
-  glUniform1i(u_unlit_, 0);
-  // planes first, pushed back in depth so that shapes lying on them win
+  // planes first, pushed back in depth so that shapes lying on them win; shaded as kFragment would
   glEnable(GL_POLYGON_OFFSET_FILL);
   glPolygonOffset(1.0f, 1.0f);
-  for (const Primitive& p : scene.solids)
-    if (p.kind == Kind::kPlane) drawMesh(quad_, poseMatrix(p.pose, {p.length, p.length, 1.0}), p.colour, false);
+  glUseProgram(flat_program_);
+  glBindVertexArray(quad_.vao);
+  bound_vao_ = quad_.vao;
+  for (const Primitive& p : scene.solids) {
+    if (p.kind != Kind::kPlane) continue;
+    const Eigen::Matrix4d model = poseMatrix(p.pose, {p.length, p.length, 1.0});
+    const Eigen::Matrix3d nm = (view_.block<3, 3>(0, 0) * model.block<3, 3>(0, 0)).inverse().transpose();
+    const float d = std::abs((nm * Eigen::Vector3d::UnitZ()).normalized().cast<float>().dot(light));
+    const float shade = 0.35f + 0.65f * d;
+    const Eigen::Matrix4f mvp = (view_proj_ * model).cast<float>();
+    glUniformMatrix4fv(u_flat_mvp_, 1, GL_FALSE, mvp.data());
+    glUniform4f(u_flat_colour_, p.colour[0] * shade, p.colour[1] * shade, p.colour[2] * shade, p.colour[3]);
+    glDrawElements(GL_TRIANGLES, quad_.count, GL_UNSIGNED_INT, nullptr);
+    ++stats_.draw_calls;
+    stats_.triangles += quad_.count / 3;
+  }
   glDisable(GL_POLYGON_OFFSET_FILL);
+  glUseProgram(program_);
+  glUniform3f(u_light_, light.x(), light.y(), light.z());
+  glUniform1i(u_unlit_, 0);
   for (const Primitive& p : scene.solids) {
     switch (p.kind) {
       case Kind::kPlane: break;

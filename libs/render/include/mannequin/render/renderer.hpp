@@ -118,6 +118,8 @@ class Renderer {
 
   unsigned program_ = 0;
   int u_mvp_ = -1, u_normal_ = -1, u_colour_ = -1, u_unlit_ = -1, u_light_ = -1;
+  unsigned flat_program_ = 0;  // one colour per draw: planes
+  int u_flat_mvp_ = -1, u_flat_colour_ = -1;
   std::array<Mesh, kLevels.size()> sphere_, hemisphere_, cylinder_, tube_, cone_;  // tube: the open cylinder of a capsule
   Mesh box_, quad_;
   unsigned line_vao_ = 0, line_vbo_ = 0;
