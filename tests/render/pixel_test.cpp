@@ -453,6 +453,43 @@ TEST_F(Headless, ClosedShapesHideWhatIsInsideThemFromEverySide) {
   }
 }
 
+// Round shapes take a coarser tessellation the smaller they are on screen (at most 0.2 px from the true
+// outline; the finest, 24 slices, up to ≈ 23 px of radius, beyond which it strays more). A sphere centred on
+// the view axis projects to a disc of radius (h / 2) · P₁₁ · r / √(d² − r²) pixels: from 1 to 19 px, every
+// pixel whose centre is more than half a pixel inside that disc is the sphere's, and none more than half a
+// pixel outside it.
+TEST_F(Headless, ASphereCoversItsProjectedDiscToHalfAPixelAtEverySize) {
+  const auto isRed = [](const std::array<std::uint8_t, 3>& c) { return c[0] > 60 && c[1] < 20 && c[2] < 20; };
+  OrbitCamera orbit;
+  orbit.target = Vec3(0.1, 0.2, 0.3);
+  orbit.distance = 3.0;
+  const Camera cam = orbit.camera(static_cast<double>(kW) / kH);
+  const Eigen::Vector2d c = cam.pixel(orbit.target, kW, kH);
+  for (double r : {0.01, 0.02, 0.03, 0.04, 0.06, 0.08, 0.12, 0.2}) {
+    RenderScene s;
+    Primitive p;
+    p.kind = Kind::kSphere;
+    p.pose = SE3(Eigen::AngleAxisd(0.7, Vec3(1, -1, 2).normalized()).toRotationMatrix(), orbit.target);
+    p.radius = r;
+    p.colour = {1, 0, 0, 1};
+    s.solids.push_back(p);
+    const double r_px = 0.5 * kH * cam.projection(1, 1) * r / std::sqrt(orbit.distance * orbit.distance - r * r);
+    const Image img = render(s, cam);
+    int missing = 0, extra = 0, red = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        const double dist = (Eigen::Vector2d(x + 0.5, y + 0.5) - c).norm();
+        const bool in = isRed(img.at(x, y));
+        red += in;
+        missing += !in && dist < r_px - 0.5;
+        extra += in && dist > r_px + 0.5;
+      }
+    EXPECT_EQ(missing, 0) << "r " << r << " (" << r_px << " px)";
+    EXPECT_EQ(extra, 0) << "r " << r << " (" << r_px << " px)";
+    EXPECT_GT(red, 0) << "r " << r << " (" << r_px << " px)";
+  }
+}
+
 }  // namespace
 }  // namespace mannequin::render
 
