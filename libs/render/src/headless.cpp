@@ -97,11 +97,9 @@ Image HeadlessContext::read() const {
   for (std::size_t y = 0; y < h; ++y) {  // GL rows are bottom-up
     const std::uint8_t* src = raw_.data() + (h - 1 - y) * w * 4;
     std::uint8_t* dst = img.rgb.data() + y * w * 3;
-    for (std::size_t x = 0; x < w; ++x) {
-      dst[3 * x] = src[4 * x];
-      dst[3 * x + 1] = src[4 * x + 1];
-      dst[3 * x + 2] = src[4 * x + 2];
-    }
+    // a pixel's 4 bytes stored at its 3-byte place: the 4th (alpha) is overwritten by the next pixel's red
+    for (std::size_t x = 0; x + 1 < w; ++x) std::memcpy(dst + 3 * x, src + 4 * x, 4);
+    std::memcpy(dst + 3 * (w - 1), src + 4 * (w - 1), 3);
   }
   return img;
 }
