@@ -14,6 +14,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <ctime>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -91,11 +92,22 @@ struct Fixture {
   render::ViewConfig view;
 };
 
-// buildScene + draw + glFinish (what a headless node does before reading back).
+// CPU time of the whole process (every thread: llvmpipe's rasteriser threads too), ns.
+std::int64_t processCpuNs() {
+  timespec t{};
+  ::clock_gettime(CLOCK_PROCESS_CPUTIME_ID, &t);
+  return static_cast<std::int64_t>(t.tv_sec) * 1'000'000'000LL + t.tv_nsec;
+}
+
+// buildScene + draw + read-back (glFinish, glReadPixels, rows flipped), what a headless node does per frame
+// before writing the PNG. Counters: fps; process_cpu_ms = CPU time of all the process's threads per frame
+// (the calling thread and llvmpipe's rasterisers: what the frame costs the host's cores, less sensitive to
+// other load on a shared host than the wall time); draws and triangles of the last frame.
 void BM_HeadlessFrame(benchmark::State& state) {
   const int w = static_cast<int>(state.range(0)), h = static_cast<int>(state.range(1));
   Fixture f(w, h);
   const render::Camera cam = f.view.camera(w, h);
+  const std::int64_t cpu0 = processCpuNs();
   for (auto _ : state) {
     const render::RenderScene scene = render::buildScene(f.ws, f.assets, f.view.style);
     f.renderer->draw(scene, cam, w, h, f.view.background);
@@ -103,6 +115,9 @@ void BM_HeadlessFrame(benchmark::State& state) {
     benchmark::DoNotOptimize(img.rgb.data());
   }
   state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
+  state.counters["process_cpu_ms"] = static_cast<double>(processCpuNs() - cpu0) * 1e-6 / static_cast<double>(std::max<std::int64_t>(1, state.iterations()));
+  state.counters["draws"] = f.renderer->stats().draw_calls;
+  state.counters["triangles"] = static_cast<double>(f.renderer->stats().triangles);
   state.SetLabel(render::Renderer::describeContext());
 }
 BENCHMARK(BM_HeadlessFrame)->Args({1280, 720})->Args({640, 360})->Unit(benchmark::kMillisecond)->UseRealTime();
@@ -121,6 +136,23 @@ void BM_HeadlessDrawOnly(benchmark::State& state) {
   state.counters["fps"] = benchmark::Counter(static_cast<double>(state.iterations()), benchmark::Counter::kIsRate);
 }
 BENCHMARK(BM_HeadlessDrawOnly)->Args({1280, 720})->Unit(benchmark::kMillisecond)->UseRealTime();
+
+// writePng of the benchmark's 1280×720 frame to a temporary file: arg 0 PngSpeed::kSmall, 1 kFast
+// (a live headless node writes its frame with kFast before it counts as swapped). Counter: bytes written.
+void BM_WritePng(benchmark::State& state) {
+  const render::PngSpeed speed = state.range(0) != 0 ? render::PngSpeed::kFast : render::PngSpeed::kSmall;
+  render::Image img;
+  {
+    Fixture f(1280, 720);
+    f.renderer->draw(render::buildScene(f.ws, f.assets, f.view.style), f.view.camera(1280, 720), 1280, 720, f.view.background);
+    img = f.ctx.read();
+  }
+  const std::string path = (std::filesystem::temp_directory_path() / ("bench-render-" + std::to_string(::getpid()) + ".png")).string();
+  for (auto _ : state) render::writePng(path, img, speed);
+  state.counters["bytes"] = static_cast<double>(std::filesystem::file_size(path));
+  std::filesystem::remove(path);
+}
+BENCHMARK(BM_WritePng)->Arg(0)->Arg(1)->Unit(benchmark::kMillisecond);
 
 // buildScene alone (no GL): the CPU cost of the scene model per frame.
 void BM_BuildScene(benchmark::State& state) {

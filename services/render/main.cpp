@@ -373,7 +373,7 @@ int runHeadless(const Options& o, const render::ViewConfig& view, render::SceneA
       // the swap: the frame goes out now
       char name[64];
       std::snprintf(name, sizeof name, "frame_%06llu.png", static_cast<unsigned long long>(step));
-      render::writePng((fs::path(o.out) / name).string(), img);
+      render::writePng((fs::path(o.out) / name).string(), img, render::PngSpeed::kFast);
       log << step << ' ' << std::chrono::steady_clock::now().time_since_epoch().count() << '\n' << std::flush;
       ++written;
       link.frameDrawn();

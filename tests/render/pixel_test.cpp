@@ -391,6 +391,105 @@ TEST_F(Scenes, RenderingIsDeterministicAndWritesAPng) {
   EXPECT_THROW(writePng("/nonexistent/dir/x.png", a), RenderError);
 }
 
+// The renderer culls the back faces of closed shapes (spheres, boxes, cylinders, cones, capsules: half
+// spheres on an open cylinder). Were a shape's triangles wound the wrong way, its near faces would be culled
+// and its far ones drawn: a sphere inside it would then show through. From twelve directions, a shape hides
+// a sphere at its centre (a capsule one at each end's centre too) and covers the pixel of its centre.
+TEST_F(Headless, ClosedShapesHideWhatIsInsideThemFromEverySide) {
+  const Colour red{1, 0, 0, 1}, green{0, 1, 0, 1};
+  const auto isRed = [](const std::array<std::uint8_t, 3>& c) { return c[0] > 60 && c[1] < 20 && c[2] < 20; };
+  const auto isGreen = [](const std::array<std::uint8_t, 3>& c) { return c[1] > 60 && c[0] < 20 && c[2] < 20; };
+  const SE3 tilted(Eigen::AngleAxisd(0.3, Vec3(1, 2, 3).normalized()).toRotationMatrix(), Vec3(0.05, -0.03, 0.02));
+  struct Case {
+    Kind kind;
+    const char* what;
+    std::vector<Vec3> inside;  // shape frame
+  };
+  const std::vector<Case> cases{{Kind::kSphere, "sphere", {Vec3::Zero()}},
+                                {Kind::kBox, "box", {Vec3::Zero()}},
+                                {Kind::kCylinder, "cylinder", {Vec3::Zero()}},
+                                {Kind::kCone, "cone", {Vec3(0, 0, 0.1)}},
+                                {Kind::kCapsule, "capsule", {Vec3::Zero(), Vec3(0, 0, -0.2), Vec3(0, 0, 0.2)}}};
+  for (const Case& c : cases) {
+    RenderScene s;
+    Primitive p;
+    p.kind = c.kind;
+    p.pose = tilted;
+    p.radius = 0.15;
+    p.length = c.kind == Kind::kCone ? 0.35 : 0.4;
+    p.size = Vec3(0.3, 0.25, 0.35);
+    p.colour = red;
+    s.solids.push_back(p);
+    for (const Vec3& q : c.inside) {
+      Primitive in;
+      in.kind = Kind::kSphere;
+      in.pose = SE3(Eigen::Matrix3d::Identity(), tilted.act(q));
+      in.radius = 0.06;
+      in.colour = green;
+      s.solids.push_back(in);
+    }
+    const Vec3 centre = tilted.act(c.kind == Kind::kCone ? Vec3(0, 0, 0.1) : Vec3::Zero());
+    for (double yaw : {0.0, 1.5707963, 3.1415926, -1.5707963})
+      for (double pitch : {-1.2, 0.0, 1.2}) {
+        OrbitCamera orbit;
+        orbit.target = centre;
+        orbit.distance = 1.5;
+        orbit.yaw = yaw;
+        orbit.pitch = pitch;
+        const Camera cam = orbit.camera(static_cast<double>(kW) / kH);
+        const Image img = render(s, cam);
+        int red_n = 0, green_n = 0;
+        for (int y = 0; y < kH; ++y)
+          for (int x = 0; x < kW; ++x) {
+            red_n += isRed(img.at(x, y));
+            green_n += isGreen(img.at(x, y));
+          }
+        const Eigen::Vector2d px = cam.pixel(centre, kW, kH);
+        EXPECT_EQ(green_n, 0) << c.what << " yaw " << yaw << " pitch " << pitch;
+        EXPECT_GT(red_n, 500) << c.what << " yaw " << yaw << " pitch " << pitch;
+        EXPECT_TRUE(isRed(img.at(static_cast<int>(px.x()), static_cast<int>(px.y()))))
+            << c.what << " yaw " << yaw << " pitch " << pitch;
+      }
+  }
+}
+
+// Round shapes take a coarser tessellation the smaller they are on screen (at most 0.2 px from the true
+// outline; the finest, 24 slices, up to ≈ 23 px of radius, beyond which it strays more). A sphere centred on
+// the view axis projects to a disc of radius (h / 2) · P₁₁ · r / √(d² − r²) pixels: from 1 to 19 px, every
+// pixel whose centre is more than half a pixel inside that disc is the sphere's, and none more than half a
+// pixel outside it.
+TEST_F(Headless, ASphereCoversItsProjectedDiscToHalfAPixelAtEverySize) {
+  const auto isRed = [](const std::array<std::uint8_t, 3>& c) { return c[0] > 60 && c[1] < 20 && c[2] < 20; };
+  OrbitCamera orbit;
+  orbit.target = Vec3(0.1, 0.2, 0.3);
+  orbit.distance = 3.0;
+  const Camera cam = orbit.camera(static_cast<double>(kW) / kH);
+  const Eigen::Vector2d c = cam.pixel(orbit.target, kW, kH);
+  for (double r : {0.01, 0.02, 0.03, 0.04, 0.06, 0.08, 0.12, 0.2}) {
+    RenderScene s;
+    Primitive p;
+    p.kind = Kind::kSphere;
+    p.pose = SE3(Eigen::AngleAxisd(0.7, Vec3(1, -1, 2).normalized()).toRotationMatrix(), orbit.target);
+    p.radius = r;
+    p.colour = {1, 0, 0, 1};
+    s.solids.push_back(p);
+    const double r_px = 0.5 * kH * cam.projection(1, 1) * r / std::sqrt(orbit.distance * orbit.distance - r * r);
+    const Image img = render(s, cam);
+    int missing = 0, extra = 0, red = 0;
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        const double dist = (Eigen::Vector2d(x + 0.5, y + 0.5) - c).norm();
+        const bool in = isRed(img.at(x, y));
+        red += in;
+        missing += !in && dist < r_px - 0.5;
+        extra += in && dist > r_px + 0.5;
+      }
+    EXPECT_EQ(missing, 0) << "r " << r << " (" << r_px << " px)";
+    EXPECT_EQ(extra, 0) << "r " << r << " (" << r_px << " px)";
+    EXPECT_GT(red, 0) << "r " << r << " (" << r_px << " px)";
+  }
+}
+
 }  // namespace
 }  // namespace mannequin::render
 

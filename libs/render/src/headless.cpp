@@ -84,17 +84,23 @@ void HeadlessContext::makeCurrent() {
 Image HeadlessContext::read() const {
   glFinish();
   glBindFramebuffer(GL_READ_FRAMEBUFFER, fbo_);
-  glPixelStorei(GL_PACK_ALIGNMENT, 1);
+  glPixelStorei(GL_PACK_ALIGNMENT, 4);
   Image img;
   img.width = width_;
   img.height = height_;
-  std::vector<std::uint8_t> raw(static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_) * 3);
-  glReadPixels(0, 0, width_, height_, GL_RGB, GL_UNSIGNED_BYTE, raw.data());
-  img.rgb.resize(raw.size());
-  const std::size_t row = static_cast<std::size_t>(width_) * 3;
-  for (int y = 0; y < height_; ++y)  // GL rows are bottom-up
-    std::memcpy(img.rgb.data() + static_cast<std::size_t>(y) * row,
-                raw.data() + static_cast<std::size_t>(height_ - 1 - y) * row, row);
+  // read RGBA, the renderbuffer's own format (Mesa copies it as is; GL_RGB would be converted pixel by pixel
+  // on this thread), into a buffer kept between frames, then drop alpha and flip rows in one pass
+  const std::size_t w = static_cast<std::size_t>(width_), h = static_cast<std::size_t>(height_);
+  raw_.resize(w * h * 4);
+  glReadPixels(0, 0, width_, height_, GL_RGBA, GL_UNSIGNED_BYTE, raw_.data());
+  img.rgb.resize(w * h * 3);
+  for (std::size_t y = 0; y < h; ++y) {  // GL rows are bottom-up
+    const std::uint8_t* src = raw_.data() + (h - 1 - y) * w * 4;
+    std::uint8_t* dst = img.rgb.data() + y * w * 3;
+    // a pixel's 4 bytes stored at its 3-byte place: the 4th (alpha) is overwritten by the next pixel's red
+    for (std::size_t x = 0; x + 1 < w; ++x) std::memcpy(dst + 3 * x, src + 4 * x, 4);
+    std::memcpy(dst + 3 * (w - 1), src + 4 * (w - 1), 3);
+  }
   return img;
 }
 

@@ -42,8 +42,13 @@ struct Image {
   }
 };
 
+/// How writePng trades file size for time. kSmall: libpng's defaults (zlib level 6, every row filter
+/// tried per row). kFast: zlib level 1 with run-length matching and the Up filter only, about 4× faster
+/// and a fifth larger on rendered frames (bench-render BM_WritePng); the pixels are the same (PNG is lossless). Live headless nodes use kFast (the
+/// PNG is written before the frame counts as swapped).
+enum class PngSpeed { kSmall, kFast };
 /// Writes an 8-bit RGB PNG (libpng). \throws RenderError naming the file.
-void writePng(const std::string& path, const Image& image);
+void writePng(const std::string& path, const Image& image, PngSpeed speed = PngSpeed::kSmall);
 /// Reads a PNG (any bit depth and colour type libpng converts: palette, grey, alpha dropped, 16-bit
 /// stripped) as 8-bit RGB. \throws RenderError naming the file (missing, not a PNG, truncated).
 Image readPng(const std::string& path);
@@ -80,25 +85,53 @@ class Renderer {
   /// eye's half, so that the text is in both eyes' images at the same place (on the screen plane).
   void drawOverlay(const std::vector<Segment2>& segments, int x, int width, int height, const Colour& colour);
 
+  /// What the last draw() (all eyes of the last draw(scene, eyes, ...)) sent to GL: draw calls and triangles
+  /// of the solids (lines and the overlay not counted). bench-render reports them.
+  struct Stats {
+    int draw_calls = 0;
+    long triangles = 0;
+  };
+  const Stats& stats() const { return stats_; }
+
   /// GL_RENDERER and GL_VERSION of the current context ("llvmpipe (LLVM 15.0.6, 256 bits) | 4.5 (Core Profile) Mesa ...").
   static std::string describeContext();
 
  private:
   struct Mesh {
-    unsigned vao = 0, vbo = 0;
+    unsigned vao = 0, vbo = 0, ebo = 0;  // ebo ≠ 0: indexed (count indices), else count vertices
     int count = 0;
   };
   Mesh upload(const std::vector<float>& interleaved);  // x y z nx ny nz per vertex, triangles
-  void drawMesh(const Mesh& mesh, const Eigen::Matrix4d& model, const Colour& colour);
+  Mesh upload(const std::vector<float>& interleaved, const std::vector<unsigned>& indices);  // indexed triangles
+  void drawMesh(const Mesh& mesh, const Eigen::Matrix4d& model, const Colour& colour, bool closed);
   const Mesh& meshFor(const collision::TriangleMesh& m);
+  /// Tessellation of round shapes (spheres, capsules, cylinders, cones): level 0 is the finest. A shape
+  /// takes the coarsest level whose polygon strays at most kMaxSagittaPx pixels from the true outline
+  /// (radius_px · (1 − cos(π / slices))) at its nearest point to the eye.
+  struct Level {
+    int slices, stacks;  // stacks even (a capsule's end is half a sphere)
+  };
+  static constexpr std::array<Level, 3> kLevels{{{24, 14}, {12, 8}, {8, 6}}};
+  static constexpr double kMaxSagittaPx = 0.2;
+  /// The level of a round shape of `radius` around the axis segment [a, b] (world frame).
+  std::size_t level(const Eigen::Vector3d& a, const Eigen::Vector3d& b, double radius) const;
 
   unsigned program_ = 0;
   int u_mvp_ = -1, u_normal_ = -1, u_colour_ = -1, u_unlit_ = -1, u_light_ = -1;
-  Mesh sphere_, cylinder_, cone_, box_, quad_;
+  unsigned flat_program_ = 0;  // one colour per draw: planes
+  int u_flat_mvp_ = -1, u_flat_colour_ = -1;
+  std::array<Mesh, kLevels.size()> sphere_, hemisphere_, cylinder_, tube_, cone_;  // tube: the open cylinder of a capsule
+  Mesh box_, quad_;
   unsigned line_vao_ = 0, line_vbo_ = 0;
   std::map<const collision::TriangleMesh*, Mesh> meshes_;
   Eigen::Matrix4d view_proj_ = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d view_ = Eigen::Matrix4d::Identity();
+  Eigen::Matrix4d proj_ = Eigen::Matrix4d::Identity();
+  double pixels_per_unit_ = 1.0;
+  // GL state as last set in draw(), so that unchanged state is not sent again
+  bool culling_ = false, mirrored_ = false, in_eyes_ = false;
+  unsigned bound_vao_ = 0;
+  Stats stats_;
 };
 
 /// An off-screen OpenGL 3.3 core context with a width × height framebuffer (see the file comment).
@@ -123,6 +156,7 @@ class HeadlessContext {
   void* display_ = nullptr;
   void* context_ = nullptr;
   unsigned fbo_ = 0, colour_ = 0, depth_ = 0;
+  mutable std::vector<std::uint8_t> raw_;  // read(): the RGBA pixels as GL gives them, kept between frames
 };
 
 }  // namespace mannequin::render
