@@ -1,32 +1,16 @@
 #include "mannequin/recording/mcap.hpp"
 
+#include <zlib.h>
+
 #include <cstdio>
 
 #include "wire.hpp"
 
 namespace mannequin::recording {
 
-namespace {
-
-struct CrcTable {
-  std::uint32_t t[256];
-  CrcTable() {
-    for (std::uint32_t i = 0; i < 256; ++i) {
-      std::uint32_t c = i;
-      for (int k = 0; k < 8; ++k) c = (c & 1U) ? (0xEDB88320U ^ (c >> 1)) : (c >> 1);
-      t[i] = c;
-    }
-  }
-};
-
-}  // namespace
-
 std::uint32_t crc32(const void* data, std::size_t n, std::uint32_t crc) {
-  static const CrcTable table;  // immutable after construction
-  const auto* p = static_cast<const std::uint8_t*>(data);
-  std::uint32_t c = crc ^ 0xFFFFFFFFU;
-  for (std::size_t i = 0; i < n; ++i) c = table.t[(c ^ p[i]) & 0xFFU] ^ (c >> 8);
-  return c ^ 0xFFFFFFFFU;
+  // zlib's: the same CRC (a running value continues across calls), several bytes per step
+  return static_cast<std::uint32_t>(::crc32_z(crc, static_cast<const Bytef*>(data), n));
 }
 
 std::string opcodeName(std::uint8_t opcode) {
