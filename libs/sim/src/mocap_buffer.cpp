@@ -1,5 +1,7 @@
 #include "mannequin/sim/mocap_buffer.hpp"
 
+#include <algorithm>
+
 namespace mannequin::sim {
 
 namespace {
@@ -43,9 +45,10 @@ BodySample MocapBuffer::sample(const std::string& body, std::int64_t t_ns) const
       out.ever_tracked = true;
     }
   if (frames_.empty()) return out;
-  // first frame after t
-  std::size_t k = 0;
-  while (k < frames_.size() && frames_[k].stamp_ns <= t_ns) ++k;
+  // first frame after t (frames are in stamp order: add() refuses older ones)
+  const std::size_t k = static_cast<std::size_t>(
+      std::upper_bound(frames_.begin(), frames_.end(), t_ns, [](std::int64_t t, const mocap::Frame& f) { return t < f.stamp_ns; }) -
+      frames_.begin());
   if (k == frames_.size() || k == 0) {  // past the newest (or before the oldest): that frame
     const mocap::Frame& f = k == 0 ? frames_.front() : frames_.back();
     const mocap::Body* b = findBody(f, body);
@@ -58,7 +61,10 @@ BodySample MocapBuffer::sample(const std::string& body, std::int64_t t_ns) const
   const mocap::Frame& f0 = frames_[k - 1];
   const mocap::Frame& f1 = frames_[k];
   const mocap::Body* b0 = findBody(f0, body);
-  const mocap::Body* b1 = findBody(f1, body);
+  // a source sends its bodies in the same order frame after frame: try b0's place in f1 first
+  const std::size_t i0 = b0 != nullptr ? static_cast<std::size_t>(b0 - f0.bodies.data()) : 0;
+  const mocap::Body* b1 =
+      b0 != nullptr && i0 < f1.bodies.size() && f1.bodies[i0].name == body ? &f1.bodies[i0] : findBody(f1, body);
   const bool t0 = b0 != nullptr && b0->tracked, t1 = b1 != nullptr && b1->tracked;
   if (t0 && t1) {
     const double gamma = static_cast<double>(t_ns - f0.stamp_ns) / static_cast<double>(f1.stamp_ns - f0.stamp_ns);
