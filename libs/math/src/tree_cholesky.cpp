@@ -18,6 +18,7 @@ TreeCholesky::TreeCholesky(std::vector<int> parent) : parent_(std::move(parent))
     start_[static_cast<std::size_t>(i) + 1] = static_cast<int>(anc_.size());
   }
   d_.setZero(n);
+  d_inv_.setZero(n);
   l_.setZero(static_cast<Eigen::Index>(anc_.size()));
 }
 
@@ -50,10 +51,11 @@ Eigen::ComputationInfo TreeCholesky::compute(const Eigen::Ref<const MatrixX>& b)
       return info_;
     }
     d[k] = std::sqrt(d[k]);
+    d_inv_[k] = 1.0 / d[k];
     const int cnt = st[k + 1] - st[k];
     if (cnt == 0) continue;  // a root (l may be empty: no pointer arithmetic on it)
     double* lk = l + st[k];
-    for (int t = 0; t < cnt; ++t) lk[t] /= d[k];
+    for (int t = 0; t < cnt; ++t) lk[t] *= d_inv_[k];
     for (int t = 0; t < cnt; ++t) {
       const int i = anc[st[k] + t];
       const double lki = lk[t];
@@ -85,7 +87,7 @@ void TreeCholesky::halfSolveInPlace(Eigen::Ref<VectorX> x) const {
   double* xp = x.data();
   for (int k = size() - 1; k >= 0; --k) {
     if (xp[k] == 0.0) continue;
-    const double yk = xp[k] / d_[k];
+    const double yk = xp[k] * d_inv_[k];
     xp[k] = yk;
     for (int t = st[k]; t < st[k + 1]; ++t) xp[anc[t]] -= l[t] * yk;
   }
@@ -102,7 +104,7 @@ void TreeCholesky::solveInPlace(Eigen::Ref<VectorX> x) const {
   for (int k = 0; k < n; ++k) {
     double s = xp[k];
     for (int t = st[k]; t < st[k + 1]; ++t) s -= l[t] * xp[anc[t]];
-    xp[k] = s / d_[k];
+    xp[k] = s * d_inv_[k];
   }
 }
 

@@ -52,6 +52,7 @@ class TreeCholesky {
   // ancestors i = anc_[·], nearest first (so the ancestors of the t-th are the ones after it)
   std::vector<int> start_, anc_;
   VectorX d_, l_;
+  VectorX d_inv_;  // 1 / d_: the solves multiply (a division's latency chains through a solve)
   Eigen::ComputationInfo info_ = Eigen::InvalidInput;
 };
 
