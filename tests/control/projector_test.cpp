@@ -142,6 +142,31 @@ TEST(PriorityGramFactor, EveryPrefixGivesTheProjectorOfItsRowsOnRandomAndRankDef
   EXPECT_THROW(f.projectTorque(J, w, 13, g, out), std::invalid_argument);
 }
 
+TEST(PriorityGramFactor, TheAvx2AndPortableUpdatesGiveTheSameBits) {
+  // where the CPU has AVX2 the column updates run 4 doubles wide; without FMA they round alike, so both
+  // paths project every torque to the same bits (where it has not, both are the portable code)
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(0.5, 20.0);
+  MatrixX J = randomMatrix(36, 43, rng);
+  J.row(20) = J.row(3) - 0.5 * J.row(11);  // a dependent row
+  VectorX w(43);
+  for (int i = 0; i < 43; ++i) w(i) = u(rng);
+  const VectorX w_inv = w.cwiseInverse();
+  const MatrixX G = J * w_inv.asDiagonal() * J.transpose();
+  PriorityGramFactor wide(36, 43, 1e-9, true), portable(36, 43, 1e-9, false);
+  wide.compute(G);
+  portable.compute(G);
+  EXPECT_EQ(wide.rank(36), portable.rank(36));
+  EXPECT_EQ(portable.rank(36), 35);
+  for (int m : {6, 18, 36}) {
+    const VectorX g = randomMatrix(43, 1, rng);
+    VectorX a, b;
+    wide.projectTorque(J, w_inv, m, g, a);
+    portable.projectTorque(J, w_inv, m, g, b);
+    EXPECT_EQ(a, b) << "prefix " << m;
+  }
+}
+
 TEST(PriorityGramFactor, MannequinPrioritisedFramesAtTheStandingPosture) {
   // the controller's J (rows in priority order) at straight knees, where the 36 rows lose rank: every
   // prefix's projector and rank as the SVD of those rows

@@ -82,7 +82,9 @@ class PriorityGramFactor {
  public:
   PriorityGramFactor() = default;
   /// \param rows task rows (may be 0), \param n joint velocities, \param rank_tolerance in (0, 1).
-  PriorityGramFactor(int rows, int n, double rank_tolerance);
+  /// allow_avx2: the factorisation's column updates use AVX2 where the CPU has it (the same results, bit
+  /// for bit: no fused multiply-add); false forces the SSE2 code (tests compare the two).
+  PriorityGramFactor(int rows, int n, double rank_tolerance, bool allow_avx2 = true);
   /// Factorises G (rows × rows, lower triangle read).
   void compute(const Eigen::Ref<const MatrixX>& G);
   /// out = Πᵀ g for the task made of the first m rows of J (the J whose Gram was factorised; w_inv
@@ -95,6 +97,7 @@ class PriorityGramFactor {
  private:
   int rows_ = 0, n_ = 0;
   double tol_ = 1e-8;
+  bool avx2_ = false;
   MatrixX L_;      // (rows × rows) L below the diagonal (the diagonal and above: scratch)
   VectorX d_;     // (rows) pivots, 0 for dropped rows
   VectorX v_;     // (rows) the Schur column being eliminated
