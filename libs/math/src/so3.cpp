@@ -23,6 +23,22 @@ Vector3 vee(const Matrix3& W) {
   return 0.5 * Vector3(W(2, 1) - W(1, 2), W(0, 2) - W(2, 0), W(1, 0) - W(0, 1));
 }
 
+namespace {
+/// I + a[ω] + b[ω]², with [ω]² = ω ωᵀ − |ω|² I (no 3 × 3 product): Rodrigues' form of exp and of the
+/// SO(3) Jacobians.
+Matrix3 identityPlusHat(const Vector3& w, double a, double b) {
+  const double c = 1.0 - b * w.squaredNorm();
+  const double bx = b * w.x(), by = b * w.y(), bz = b * w.z();
+  const double ax = a * w.x(), ay = a * w.y(), az = a * w.z();
+  const double bxy = bx * w.y(), bxz = bx * w.z(), byz = by * w.z();
+  Matrix3 R;
+  R << c + bx * w.x(), bxy - az, bxz + ay,
+       bxy + az, c + by * w.y(), byz - ax,
+       bxz - ay, byz + ax, c + bz * w.z();
+  return R;
+}
+}  // namespace
+
 Matrix3 expSO3(const Vector3& w) {
   // Rodrigues (thesis 1.11): I + a[ω] + b[ω]², a = sinθ/θ, b = (1−cosθ)/θ²
   const double t2 = w.squaredNorm();
@@ -35,16 +51,7 @@ Matrix3 expSO3(const Vector3& w) {
     a = std::sin(t) / t;
     b = (1.0 - std::cos(t)) / t2;
   }
-  // [ω]² = ω ωᵀ − θ² I: R = (1 − bθ²) I + a[ω] + b ω ωᵀ (no 3 × 3 product)
-  const double c = 1.0 - b * t2;
-  const double bx = b * w.x(), by = b * w.y(), bz = b * w.z();
-  const double ax = a * w.x(), ay = a * w.y(), az = a * w.z();
-  const double bxy = bx * w.y(), bxz = bx * w.z(), byz = by * w.z();
-  Matrix3 R;
-  R << c + bx * w.x(), bxy - az, bxz + ay,
-       bxy + az, c + by * w.y(), byz - ax,
-       bxz - ay, byz + ax, c + bz * w.z();
-  return R;
+  return identityPlusHat(w, a, b);
 }
 
 Vector3 logSO3(const Matrix3& R) {
@@ -97,23 +104,13 @@ double inverseCoefficient(const Vector3& w) {
 Matrix3 rightJacobianSO3(const Vector3& w) {
   double a, b;
   jacobianCoefficients(w, &a, &b);
-  const Matrix3 W = hat(w);
-  return Matrix3::Identity() - a * W + b * W * W;
+  return identityPlusHat(w, -a, b);
 }
 
 Matrix3 leftJacobianSO3(const Vector3& w) {
   double a, b;
   jacobianCoefficients(w, &a, &b);
-  // I + a[ω] + b[ω]² with [ω]² = ω ωᵀ − θ² I (no 3 × 3 product)
-  const double c = 1.0 - b * w.squaredNorm();
-  const double bx = b * w.x(), by = b * w.y(), bz = b * w.z();
-  const double ax = a * w.x(), ay = a * w.y(), az = a * w.z();
-  const double bxy = bx * w.y(), bxz = bx * w.z(), byz = by * w.z();
-  Matrix3 R;
-  R << c + bx * w.x(), bxy - az, bxz + ay,
-       bxy + az, c + by * w.y(), byz - ax,
-       bxz - ay, byz + ax, c + bz * w.z();
-  return R;
+  return identityPlusHat(w, a, b);
 }
 
 Matrix3 rightJacobianInverseSO3(const Vector3& w) {
