@@ -67,6 +67,13 @@ std::string ipcDir() {
   return dir;
 }
 
+/// The count of the subscriber that has received the fewest messages.
+std::uint64_t fewestReceived(const std::vector<std::atomic<std::uint64_t>>& counts) {
+  std::uint64_t m = ~0ull;
+  for (const auto& c : counts) m = std::min<std::uint64_t>(m, c.load());
+  return m;
+}
+
 void waitSubscribed(transport::Publisher& pub, std::uint64_t n) {
   while (pub.subscriptions() < n) {
     pub.poll();
@@ -131,11 +138,7 @@ void Throughput8(benchmark::State& state) {
     ++sent;
   }
   // wait until every subscriber has everything (or 10 s)
-  auto minCount = [&] {
-    std::uint64_t m = ~0ull;
-    for (auto& c : counts) m = std::min<std::uint64_t>(m, c.load());
-    return m;
-  };
+  const auto minCount = [&] { return fewestReceived(counts); };
   while (minCount() < sent && (transport::steadyNs() - t0) < 10'000'000'000LL) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   const double seconds = (transport::steadyNs() - t0) * 1e-9;
   done = true;
@@ -425,11 +428,7 @@ void vethThroughput(benchmark::State& state, bool curve, int io_threads, const s
       pub.publishRaw("sim.world", payload);
       ++sent;
     }
-    auto minCount = [&] {
-      std::uint64_t m = ~0ull;
-      for (auto& c : counts) m = std::min<std::uint64_t>(m, c.load());
-      return m;
-    };
+    const auto minCount = [&] { return fewestReceived(counts); };
     while (minCount() < sent && (transport::steadyNs() - t0) < 20'000'000'000LL) {
       pub.poll();
       std::this_thread::sleep_for(std::chrono::milliseconds(1));

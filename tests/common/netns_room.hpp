@@ -134,16 +134,27 @@ class Room {
   std::vector<pid_t> pids_;
 };
 
-/// Polls until every file contains `text` or the deadline; true when they all do.
-inline bool waitForText(const std::vector<fs::path>& files, const std::string& text, std::chrono::seconds timeout) {
+/// Polls `done` (e.g. a log file's content: a file has no event to wait on) every 50 ms until it holds or
+/// the deadline; true when it holds.
+template <class Done>
+bool waitUntil(Done done, std::chrono::seconds timeout) {
   const auto until = std::chrono::steady_clock::now() + timeout;
   for (;;) {
-    bool all = true;
-    for (const auto& f : files) all = all && readFile(f).find(text) != std::string::npos;
-    if (all) return true;
+    if (done()) return true;
     if (std::chrono::steady_clock::now() >= until) return false;
     std::this_thread::sleep_for(std::chrono::milliseconds(50));
   }
+}
+
+/// Until every file contains `text` or the deadline; true when they all do.
+inline bool waitForText(const std::vector<fs::path>& files, const std::string& text, std::chrono::seconds timeout) {
+  return waitUntil(
+      [&] {
+        for (const auto& f : files)
+          if (readFile(f).find(text) == std::string::npos) return false;
+        return true;
+      },
+      timeout);
 }
 
 inline std::vector<v1::WorldState> worldsIn(const fs::path& mcap) {

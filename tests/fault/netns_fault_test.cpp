@@ -17,6 +17,7 @@
 #include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
@@ -109,14 +110,20 @@ class StationWatch {
         zmq::context_t context(1);
         transport::Subscriber sub(context, {"fault-watch", {"tcp://10.77.0.2:5603"}, 1000, 10000, curve});
         sub.subscribe(transport::topics::kSimWorld, [this](const v1::WorldState& w, const transport::Received&) {
-          const std::lock_guard lock(mutex_);
-          ++count_;
-          last_ = w;
+          {
+            const std::lock_guard lock(mutex_);
+            ++count_;
+            last_ = w;
+          }
+          changed_.notify_all();
         });
         while (!stop_.load()) sub.poll(std::chrono::milliseconds(20));
       } catch (const std::exception& e) {
-        const std::lock_guard lock(mutex_);
-        error_ = e.what();
+        {
+          const std::lock_guard lock(mutex_);
+          error_ = e.what();
+        }
+        changed_.notify_all();
       }
     });
   }
@@ -128,16 +135,10 @@ class StationWatch {
   StationWatch& operator=(const StationWatch&) = delete;
   /// Waits until done(states received, the last one) holds; false at the deadline or when the watch failed.
   bool waitFor(const std::function<bool(std::uint64_t, const v1::WorldState&)>& done, std::chrono::seconds timeout) {
-    const auto until = std::chrono::steady_clock::now() + timeout;
-    for (;;) {
-      {
-        const std::lock_guard lock(mutex_);
-        if (!error_.empty()) return false;
-        if (done(count_, last_)) return true;
-      }
-      if (std::chrono::steady_clock::now() >= until) return false;
-      std::this_thread::sleep_for(std::chrono::milliseconds(10));
-    }
+    std::unique_lock lock(mutex_);
+    bool met = false;
+    changed_.wait_for(lock, timeout, [&] { return !error_.empty() || (met = done(count_, last_)); });
+    return met && error_.empty();
   }
   /// States received, the last one's sequence, its stream gaps and mocap age, any error: for failure messages.
   std::string status() {
@@ -154,6 +155,7 @@ class StationWatch {
 
  private:
   std::mutex mutex_;
+  std::condition_variable changed_;  // a state received or the watch failed
   std::uint64_t count_ = 0;
   v1::WorldState last_;
   std::string error_;
@@ -321,10 +323,7 @@ TEST(NetnsFaults, ALinkDownForTwoSecondsIsReportedAndTheRoomRecoversWithoutARest
   // count has gone past what it had before the outage by 60 (1 s at 60 Hz: the burst of what tcp kept)
   ASSERT_TRUE(watch.waitFor([&](std::uint64_t, const v1::WorldState& w) { return w.header().send_time_ns() >= station_up + 1'000'000'000; }, 30s))
       << "no sim.world sent after the station's link came back reached the station within 30 s: " << watch.status();
-  const auto recorder_caught_up = [&] { return recordedCount(readFile(dir / "record.log")) >= recorded_before + 60; };
-  for (const auto until = std::chrono::steady_clock::now() + 30s; !recorder_caught_up() && std::chrono::steady_clock::now() < until;)
-    std::this_thread::sleep_for(50ms);
-  ASSERT_TRUE(recorder_caught_up()) << "the recorder did not receive again within 30 s of the station's link coming back (" << recorded_before
+  ASSERT_TRUE(waitUntil([&] { return recordedCount(readFile(dir / "record.log")) >= recorded_before + 60; }, 30s)) << "the recorder did not receive again within 30 s of the station's link coming back (" << recorded_before
                                     << " messages before)\n" << readFile(dir / "record.log");
   EXPECT_EQ(room.stop(recorder, "mannequin-record on the station"), 0) << readFile(dir / "record.log");
   // the station's launcher saw the room late, then up again

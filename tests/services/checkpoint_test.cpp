@@ -14,17 +14,12 @@
 #include "mannequin/simservice/messages.hpp"
 #include "mannequin/simservice/sim_service.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
-
+#include "../common/pose.hpp"
 using namespace mannequin;
 using namespace mannequin::sim;
 
 namespace {
-math::SE3 pose(const math::Vector3& p, const math::Vector3& r = math::Vector3::Zero()) {
-  math::SE3 H;
-  H.R = math::expSO3(r);
-  H.p = p;
-  return H;
-}
+using mannequin::testing::pose;
 
 mocap::Frame actor(std::int64_t stamp_ns, const math::Vector3& hand_offset) {
   mocap::Frame f;

@@ -24,18 +24,14 @@
 #include "mannequin/transport/subscriber.hpp"
 #include "mannequin/transport/topics.hpp"
 #include "../common/child_process.hpp"
+#include "../common/pose.hpp"
 #include "../common/tool_run.hpp"
 
 using namespace mannequin;
 using namespace mannequin::sim;
 
 namespace {
-math::SE3 pose(const math::Vector3& p, const math::Vector3& r = math::Vector3::Zero()) {
-  math::SE3 H;
-  H.R = math::expSO3(r);
-  H.p = p;
-  return H;
-}
+using mannequin::testing::pose;
 
 mocap::Frame frame(std::int64_t stamp_ns, std::vector<mocap::Body> bodies) {
   mocap::Frame f;
