@@ -8,7 +8,9 @@
 #include <signal.h>
 #include <spawn.h>
 
+#include <algorithm>
 #include <chrono>
+#include <iterator>
 #include <map>
 #include <atomic>
 #include <thread>
@@ -89,6 +91,26 @@ TEST_F(RenderTool, MissingOrInvalidViewFileExitsTwoNamingFileAndKey) {
   EXPECT_NE(invalid.err.find(bad.string() + ":3"), std::string::npos) << invalid.err;
   EXPECT_NE(invalid.err.find("zoom"), std::string::npos) << invalid.err;
   fs::remove(bad);
+}
+
+TEST_F(RenderTool, ASceneNamingAMissingMeshExitsTwoNamingTheLineAndTheFile) {
+  // the cockpit scene with its panel mesh renamed to a file that does not exist
+  std::ifstream in("configs/scenes/cockpit.yaml");
+  std::string text((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  const std::string shipped = "file: ../../data/meshes/cockpit_panel.obj";
+  const std::size_t at = text.find(shipped);
+  ASSERT_NE(at, std::string::npos) << "configs/scenes/cockpit.yaml no longer names its panel mesh so";
+  const int line = static_cast<int>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(at), '\n')) + 1;
+  text.replace(at, shipped.size(), "file: nothere_panel.obj");
+  const fs::path scene = temp("missing_mesh_scene.yaml"), out = temp("missing_mesh_out");
+  std::ofstream(scene) << text;
+  const ToolResult r = run("--view configs/views/desktop.yaml --scene " + scene.string() + " --headless --size 64x64 --frames 1 --out " +
+                           out.string());
+  EXPECT_EQ(r.exit_code, 2) << r.err;
+  EXPECT_NE(r.err.find(scene.string() + ":" + std::to_string(line)), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find((scene.parent_path() / "nothere_panel.obj").string() + ": no such mesh file"), std::string::npos) << r.err;
+  EXPECT_FALSE(fs::exists(out)) << "a frame directory was left behind";
+  fs::remove(scene);
 }
 
 TEST_F(RenderTool, NoDisplayWithoutHeadlessExitsTwoWithTheHint) {
