@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <chrono>
 #include <iterator>
+#include <limits>
 #include <map>
 #include <atomic>
 #include <thread>
@@ -418,11 +419,35 @@ TEST_F(RenderTool, SyncedNodesSwapTheSameStepsAndADeadNodeStallsNoLongerThanTheT
     const std::vector<std::uint64_t> so = steps(other, first, a.back().first);
     for (std::uint64_t s : sa) EXPECT_TRUE(std::binary_search(so.begin(), so.end(), s)) << "step " << s;
   }
-  // wall_b and wall_c swapped the same steps, before and after the kill
+  // wall_b and wall_c swapped the same steps before the kill and again from the first step both swap after it
+  // (the barrier has dropped the dead leader: one timeout, at most one more for the frame it died in); in that frame
+  // each survivor times out on its own, so one of them may swap a step the other does not (seen under load:
+  // 924 on one wall only) — at most one such step each
   const std::uint64_t last = std::min(b.back().first, c.back().first);
-  const std::vector<std::uint64_t> sb = steps(b, first, last), sc = steps(c, first, last);
-  EXPECT_EQ(sb, sc);
-  EXPECT_GE(sb.size(), 25u);
+  const auto lastBefore = [&](const auto& v, std::int64_t t) {
+    std::uint64_t s = 0;
+    for (const auto& [step, at] : v)
+      if (at < t) s = step;
+    return s;
+  };
+  const std::uint64_t before = std::min(lastBefore(b, kill_ns), lastBefore(c, kill_ns));
+  // the first step both swapped after the kill: from there on, lockstep again
+  std::uint64_t after = std::numeric_limits<std::uint64_t>::max();
+  const std::vector<std::uint64_t> cs = steps(c, 0, last);
+  for (const auto& [step, at] : b)
+    if (at >= kill_ns && step > before && std::binary_search(cs.begin(), cs.end(), step)) {
+      after = step;
+      break;
+    }
+  ASSERT_NE(after, std::numeric_limits<std::uint64_t>::max()) << "the survivors never swapped a common step after the kill";
+  EXPECT_EQ(steps(b, first, before), steps(c, first, before)) << "before the kill";
+  EXPECT_EQ(steps(b, after, last), steps(c, after, last)) << "after the survivors resynchronised";
+  EXPECT_GE(steps(b, first, before).size(), 10u);
+  EXPECT_GE(steps(b, after, last).size(), 10u);
+  const std::vector<std::uint64_t> mb = steps(b, before + 1, after - 1), mc = steps(c, before + 1, after - 1);
+  std::vector<std::uint64_t> only;
+  std::ranges::set_symmetric_difference(mb, mc, std::back_inserter(only));
+  EXPECT_LE(only.size(), 2u) << "steps swapped by one survivor only around the kill: " << only.size();
   // steps only go forward
   for (const auto& v : {a, b, c})
     for (std::size_t i = 1; i < v.size(); ++i) EXPECT_LT(v[i - 1].first, v[i].first);
