@@ -489,29 +489,43 @@ void handsOnTable(benchmark::State& state) {
 namespace {
 
 /// The contact sweep's scene in MuJoCo: the mannequin exported by skeleton::toMjcf (same joints, masses,
-/// capsules, box feet; gravity 0 as the sweep), standing (mjcfQpos of the standing configuration), the
-/// floor and the same spheres as static geoms, with margin = 2 cm (our activation distance): MuJoCo
-/// keeps the contacts within 2 cm, all in its solver (no gap). Spheres frictionless (condim 1, priority 1
-/// so that their condim wins over the mannequin's 3) as ours; the floor with friction 0.5 (pyramidal
-/// cones: 4 rows per contact, MuJoCo's default). MuJoCo's defaults otherwise: Euler, Newton solver. No
-/// controller: MuJoCo's soft contacts push from the margin on (ours: λ = 0 until touching) and nothing
-/// holds the mannequin, so it would drift out of range; each step starts from the standing state (qpos
-/// reset, qvel 0: a copy of 51 + 43 doubles, timed with the step) to keep the pose's contact count.
-/// Times mj_step; after the run, times our World (the BM_PhysicsStep case of the same N) over as many
-/// steps with a steady clock and reports: contacts (MuJoCo's d->ncon, mean), efc (its constraint rows),
-/// ours_contacts (our contact rows, mean), ours_us, mujoco_us and ratio = ours_us / mujoco_us.
-void mujocoSweep(benchmark::State& state, int target) {
+/// capsules, box feet; gravity 0 as the sweep), the floor and the same spheres as static geoms, with
+/// margin = 2 cm (our activation distance): MuJoCo keeps the contacts within 2 cm, all in its solver (no
+/// gap). Spheres frictionless (condim 1, priority 1 so that their condim wins over the mannequin's 3) as
+/// ours; the floor with friction 0.5 (pyramidal cones: 4 rows per contact, MuJoCo's default). MuJoCo's
+/// defaults otherwise: Euler, Newton solver. No controller: MuJoCo's soft contacts push from the margin
+/// on (ours: λ = 0 until touching) and nothing holds the mannequin, so it would drift out of range; each
+/// step starts from one fixed state (qpos reset, qvel 0: a copy of 51 + 43 doubles, timed with the step).
+/// That state is our World's, settled: our World steps first (warm-up, 300 steps: the contacts push the
+/// standing mannequin a little, some of the scene's contacts leave the 2 cm range and others enter), then
+/// MuJoCo starts every step from our configuration at that moment (mjcfQpos), so both engines see the
+/// same pose in the same scene: the same contact count, up to their contact generation (the counters
+/// `contacts` and `ours_contacts` say it; the goal compares at equal contact count). Times mj_step;
+/// after the run, times our World (continuing) over as many steps with a steady clock and reports:
+/// contacts (MuJoCo's d->ncon, mean), efc (its constraint rows), ours_contacts (our contact rows, mean),
+/// ours_us, mujoco_us and ratio = ours_us / mujoco_us.
+void mujocoSweep(benchmark::State& state, int target, bool tracking) {
   // MuJoCo prints warnings on stdout (and appends them to MUJOCO_LOG.TXT): stderr keeps the JSON valid
   mju_user_warning = [](const char* msg) { std::fprintf(stderr, "bench-step: MuJoCo warning: %s\n", msg); };
   const SweepSetup setup = sweepSetup(target);
+  // ours first: settled, its configuration is MuJoCo's state
+  PhysicsRun run = sweepWorld(setup);
+  const std::vector<math::SE3> calibration = run.targets;
+  Driver driver(run, calibration);
+  for (int i = 0; i < 300; ++i) driver.step();
+  const skeleton::VectorX q_settled = run.world->q(0);
+  // our pairs become rows within the activation distance of the segments' margin shells (the scene
+  // has no margin); MuJoCo's geom margin is on the real geometry
+  const PhysicsConfig physics_defaults;
+  const double mj_margin = physics_defaults.activation_distance + physics_defaults.segment_margin;
   std::string spheres;
   for (const collision::BodySpec& b : setup.scene.bodies) {
     if (b.shapes.empty() || b.shapes[0].shape.type != collision::ShapeType::kSphere) continue;
     char buf[256];
     std::snprintf(buf, sizeof buf,
                   "    <geom name=\"%s\" type=\"sphere\" size=\"%.9g\" pos=\"%.12g %.12g %.12g\" contype=\"1\" "
-                  "conaffinity=\"1\" condim=\"1\" priority=\"1\" margin=\"0.02\"/>\n",
-                  b.name.c_str(), b.shapes[0].shape.radius, b.pose.p.x(), b.pose.p.y(), b.pose.p.z());
+                  "conaffinity=\"1\" condim=\"1\" priority=\"1\" margin=\"%.9g\"/>\n",
+                  b.name.c_str(), b.shapes[0].shape.radius, b.pose.p.x(), b.pose.p.y(), b.pose.p.z(), mj_margin);
     spheres += buf;
   }
   skeleton::MjcfOptions opt;
@@ -521,9 +535,24 @@ void mujocoSweep(benchmark::State& state, int target) {
   opt.njmax = 4000;
   if (target > 0)
     spheres += "    <geom name=\"floor\" type=\"plane\" size=\"0 0 1\" contype=\"1\" conaffinity=\"1\" condim=\"3\" "
-               "friction=\"0.5 0.005 0.0001\" margin=\"0.02\"/>\n";
+               "friction=\"0.5 0.005 0.0001\" margin=\"" + std::to_string(mj_margin) + "\"/>\n";
+  // tracking: one mocap body per driven frame (kBodies), welded to the body of the joint carrying it
+  std::vector<std::string> weld_bodies;
+  std::string equality;
+  if (tracking) {
+    equality = "  <equality>\n";
+    for (const char* b : kBodies) {
+      const skeleton::Model& model = setup.model;
+      const int j = model.frames[static_cast<std::size_t>(model.frameIndex(b))].joint;
+      weld_bodies.push_back(model.joints[static_cast<std::size_t>(j)].name);
+      spheres += std::string("    <body name=\"target_") + b + "\" mocap=\"true\"/>\n";
+      equality += "    <weld body1=\"" + weld_bodies.back() + "\" body2=\"target_" + b + "\" relpose=\"0 0 0 1 0 0 0\"/>\n";
+    }
+    equality += "  </equality>\n";
+  }
   opt.extra_worldbody = spheres;
-  const std::string xml = skeleton::toMjcf(setup.model, opt);
+  std::string xml = skeleton::toMjcf(setup.model, opt);
+  if (tracking) xml.insert(xml.rfind("</mujoco>"), equality);
   const std::string path = (std::filesystem::temp_directory_path() /
                             ("bench_step_mujoco_" + std::to_string(::getpid()) + "_" + std::to_string(target) + ".xml"))
                                .string();
@@ -536,12 +565,29 @@ void mujocoSweep(benchmark::State& state, int target) {
     return;
   }
   mjData* d = mj_makeData(m);
-  const std::vector<double> qpos = skeleton::mjcfQpos(setup.model, setup.q);
+  const std::vector<double> qpos = skeleton::mjcfQpos(setup.model, q_settled);
   for (int i = 0; i < m->nq; ++i) d->qpos[i] = qpos[static_cast<std::size_t>(i)];
   const auto reset = [&] {
     for (int i = 0; i < m->nq; ++i) d->qpos[i] = qpos[static_cast<std::size_t>(i)];
     for (int i = 0; i < m->nv; ++i) d->qvel[i] = 0.0;
   };
+  if (tracking) {  // each target where its body is in the state every step starts from
+    reset();
+    mj_forward(m, d);
+    for (std::size_t k = 0; k < weld_bodies.size(); ++k) {
+      const int b = mj_name2id(m, mjOBJ_BODY, weld_bodies[k].c_str());
+      const int t = mj_name2id(m, mjOBJ_BODY, (std::string("target_") + kBodies[k]).c_str());
+      if (b < 0 || t < 0 || m->body_mocapid[t] < 0) {
+        state.SkipWithError(("MuJoCo model: no body " + weld_bodies[k] + " or target_" + kBodies[k]).c_str());
+        mj_deleteData(d);
+        mj_deleteModel(m);
+        return;
+      }
+      const int mc = m->body_mocapid[t];
+      for (int c = 0; c < 3; ++c) d->mocap_pos[3 * mc + c] = d->xpos[3 * b + c];
+      for (int c = 0; c < 4; ++c) d->mocap_quat[4 * mc + c] = d->xquat[4 * b + c];
+    }
+  }
   for (int i = 0; i < 100; ++i) {  // warm-up, as ours
     reset();
     mj_step(m, d);
@@ -559,11 +605,7 @@ void mujocoSweep(benchmark::State& state, int target) {
   const double mujoco_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   mj_deleteData(d);
   mj_deleteModel(m);
-  // ours, the same N, as many steps (at least 200)
-  PhysicsRun run = sweepWorld(setup);
-  const std::vector<math::SE3> calibration = run.targets;
-  Driver driver(run, calibration);
-  for (int i = 0; i < 100; ++i) driver.step();
+  // ours, continuing from the settled state, as many steps (at least 200)
   const long ours_n = std::max(200L, n);
   double ours_contacts = 0;
   const auto t1 = std::chrono::steady_clock::now();
@@ -584,11 +626,13 @@ void mujocoSweep(benchmark::State& state, int target) {
 }  // namespace
 
 static void registerMujocoSweep() {
-  for (int n = 0; n <= 300; n += (n < 280 ? 10 : 20)) {
-    benchmark::RegisterBenchmark(("BM_MujocoStep/contacts:" + std::to_string(n)).c_str(),
-                                 [n](benchmark::State& st) { mujocoSweep(st, n); })
-        ->Unit(benchmark::kMicrosecond);
-  }
+  for (const bool tracking : {false, true})
+    for (int n = 0; n <= 300; n += (n < 280 ? 10 : 20)) {
+      benchmark::RegisterBenchmark(
+          ((tracking ? "BM_MujocoTrackingStep/contacts:" : "BM_MujocoStep/contacts:") + std::to_string(n)).c_str(),
+          [n, tracking](benchmark::State& st) { mujocoSweep(st, n, tracking); })
+          ->Unit(benchmark::kMicrosecond);
+    }
 }
 static const int kMujocoRegistered = (registerMujocoSweep(), 0);
 #endif

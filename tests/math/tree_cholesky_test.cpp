@@ -129,6 +129,41 @@ TEST(TreeCholesky, DenseChainAndDiagonalAreTheTwoExtremes) {
   EXPECT_LT((x - y.cwiseQuotient(b.diagonal())).norm(), 1e-14 * x.norm());
 }
 
+TEST(TreeCholesky, ThePackedPatternGivesTheSameFactorBitForBit) {
+  std::mt19937 rng(11);
+  for (int trial = 0; trial < 30; ++trial) {
+    const int n = 1 + trial % 45;
+    const auto p = randomTree(n, rng);
+    const MatrixX L = randomFactor(p, rng);
+    const MatrixX b = L.transpose() * L;
+    TreeCholesky dense(p), packed(p);
+    ASSERT_EQ(dense.compute(b), Eigen::Success);
+    // pack by packedIndex: every ancestor pair has a slot, each slot once, nothing else has one
+    VectorX diagonal = b.diagonal(), lower = VectorX::Constant(packed.packedSize(), std::nan(""));
+    for (int k = 0; k < n; ++k)
+      for (int i = 0; i < n; ++i) {
+        const int slot = packed.packedIndex(k, i);
+        const bool ancestor = i < k && related(p, k, i);
+        ASSERT_EQ(slot >= 0, ancestor) << "n = " << n << ", b(" << k << ", " << i << ")";
+        if (!ancestor) continue;
+        ASSERT_LT(slot, packed.packedSize());
+        ASSERT_TRUE(std::isnan(lower(slot))) << "slot " << slot << " given twice";
+        lower(slot) = b(k, i);
+      }
+    ASSERT_FALSE(lower.hasNaN()) << "a slot no ancestor pair fills";
+    ASSERT_EQ(packed.computePacked(diagonal, lower), Eigen::Success);
+    EXPECT_EQ(packed.matrixL(), dense.matrixL()) << "n = " << n;
+  }
+  TreeCholesky f = TreeCholesky::dense(3);
+  EXPECT_EQ(f.packedIndex(-1, 0), -1);
+  EXPECT_EQ(f.packedIndex(3, 0), -1);
+  EXPECT_THROW(f.computePacked(VectorX::Ones(2), VectorX::Zero(3)), std::invalid_argument);
+  EXPECT_THROW(f.computePacked(VectorX::Ones(3), VectorX::Zero(2)), std::invalid_argument);
+  VectorX d = VectorX::Ones(3);
+  d(1) = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(f.computePacked(d, VectorX::Zero(3)), Eigen::NumericalIssue);
+}
+
 TEST(TreeCholesky, RejectsBadTreesSizesAndIndefiniteMatrices) {
   EXPECT_THROW(TreeCholesky({-1, 1}), std::invalid_argument);   // parent not before the child
   EXPECT_THROW(TreeCholesky({-2}), std::invalid_argument);

@@ -180,9 +180,23 @@ void Controller::build(const VectorX& q0) {
   q_j_.setZero(model_.nq);
   J_.setZero(rows_, nv_);
   JB_.setZero(rows_, nv_);
-  b_.setIdentity(nv_, nv_);
   factor_ = math::TreeCholesky(model_.velocityParents());
-  factor_.compute(b_);
+  b_diag_.setOnes(nv_);
+  b_lower_.setZero(factor_.packedSize());
+  factor_.computePacked(b_diag_, b_lower_);
+  b_stale_ = true;
+  b_slots_.assign(static_cast<std::size_t>(nf), {});
+  for (int i = 0; i < nf; ++i) {
+    const std::vector<int>& cols = support_cols_[static_cast<std::size_t>(i)];
+    for (std::size_t a = 0; a < cols.size(); ++a)
+      for (std::size_t b = 0; b < a; ++b) {
+        const int slot = factor_.packedIndex(std::max(cols[a], cols[b]), std::min(cols[a], cols[b]));
+        if (slot < 0)  // a frame's support is a chain of the tree: every pair is ancestor and descendant
+          throw std::logic_error("controller: control frame '" + frames_[static_cast<std::size_t>(i)].name + "': columns " +
+                                 std::to_string(cols[a]) + " and " + std::to_string(cols[b]) + " of its support are not on one branch");
+        b_slots_[static_cast<std::size_t>(i)].push_back(slot);
+      }
+  }
   wrench_ff_.assign(nf, Vector6::Zero());
   damping_total_.assign(nf, Vector6::Zero());
   vd_c_.assign(nf, Vector6::Zero());
@@ -398,32 +412,50 @@ void Controller::couplingTerms() {
 }
 
 void Controller::assembleFriction() {
-  // b = b_a + Σ Jᵀ B J (2.17): per frame over its support columns only (JB_ is zero elsewhere), the
-  // lower triangle, then mirrored
-  b_.setZero();
-  b_.diagonal() = b_a_;
+  // b = b_a + Σ Jᵀ B J (2.17): per frame over its support columns only (JB_ is zero elsewhere), on the
+  // tree's pattern (a frame's support is one branch: every pair of its columns is in it), packed
+  b_diag_ = b_a_;
+  b_lower_.setZero();
+  double* lower = b_lower_.data();
   for (int i = 0; i < numFrames(); ++i) {
     if (!frames_[i].enabled) continue;
     const int r = frame_row_[i];
     const std::vector<int>& cols = support_cols_[i];
+    const int* slot = b_slots_[static_cast<std::size_t>(i)].data();
     for (std::size_t a = 0; a < cols.size(); ++a) {
       const auto ja = JB_.block<6, 1>(r, cols[a]);
-      for (std::size_t b = 0; b <= a; ++b) {
-        const double v = ja.dot(JB_.block<6, 1>(r, cols[b]));
-        b_(std::max(cols[a], cols[b]), std::min(cols[a], cols[b])) += v;
-      }
+      for (std::size_t b = 0; b < a; ++b) lower[*slot++] += ja.dot(JB_.block<6, 1>(r, cols[b]));
+      b_diag_(cols[a]) += ja.squaredNorm();
     }
   }
-  b_.triangularView<Eigen::StrictlyUpper>() = b_.transpose();
-  factor_.compute(b_);
+  factor_.computePacked(b_diag_, b_lower_);
+  b_stale_ = true;
+}
+
+const MatrixX& Controller::apparentFriction() const {
+  if (b_stale_) {
+    b_.setZero(nv_, nv_);
+    b_.diagonal() = b_diag_;
+    const std::vector<int>& parent = factor_.parents();
+    for (int k = 0; k < nv_; ++k)
+      for (int i = parent[static_cast<std::size_t>(k)]; i >= 0; i = parent[static_cast<std::size_t>(i)]) {
+        const int slot = factor_.packedIndex(k, i);
+        b_(k, i) = b_(i, k) = b_lower_(slot);
+      }
+    b_stale_ = false;
+  }
+  return b_;
 }
 
 void Controller::gramOfTasks() {
-  // G = J b_a⁻¹ Jᵀ, lower triangle, block by block over the columns both frames' rows reach
-  gram_.setZero();
+  // G = J b_a⁻¹ Jᵀ, lower triangle, block by block over the columns both frames' rows reach (the
+  // blocks of frames sharing no column are never written: zero since build())
   for (const FramePair& fp : frame_pairs_) {
-    if (!frames_[fp.frame_a].enabled || !frames_[fp.frame_b].enabled) continue;
     const int ra = frame_row_[fp.frame_a], rb = frame_row_[fp.frame_b];
+    if (!frames_[fp.frame_a].enabled || !frames_[fp.frame_b].enabled) {
+      gram_.block<6, 6>(ra, rb).setZero();
+      continue;
+    }
     Matrix6 block = Matrix6::Zero();
     for (int col : fp.cols) block.noalias() += (b_a_inv_(col) * J_.block<6, 1>(ra, col)) * J_.block<6, 1>(rb, col).transpose();
     gram_.block<6, 6>(ra, rb) = block;

@@ -43,6 +43,33 @@ Eigen::ComputationInfo TreeCholesky::compute(const Eigen::Ref<const MatrixX>& b)
     d[k] = b(k, k);
     for (int t = st[k]; t < st[k + 1]; ++t) l[t] = b(k, anc[t]);
   }
+  return factorInPlace();
+}
+
+int TreeCholesky::packedIndex(int k, int i) const {
+  if (k < 0 || k >= size()) return -1;
+  for (int t = start_[static_cast<std::size_t>(k)]; t < start_[static_cast<std::size_t>(k) + 1]; ++t)
+    if (anc_[static_cast<std::size_t>(t)] == i) return t;
+  return -1;
+}
+
+Eigen::ComputationInfo TreeCholesky::computePacked(const Eigen::Ref<const VectorX>& diagonal,
+                                                   const Eigen::Ref<const VectorX>& lower) {
+  if (diagonal.size() != size() || lower.size() != packedSize())
+    throw std::invalid_argument("TreeCholesky::computePacked: " + std::to_string(diagonal.size()) + " diagonal and " +
+                                std::to_string(lower.size()) + " lower entries, expected " + std::to_string(size()) +
+                                " and " + std::to_string(packedSize()));
+  d_ = diagonal;
+  l_ = lower;
+  return factorInPlace();
+}
+
+Eigen::ComputationInfo TreeCholesky::factorInPlace() {
+  const int n = size();
+  const int* st = start_.data();
+  const int* anc = anc_.data();
+  double* d = d_.data();
+  double* l = l_.data();
   // RBDA Table 6.3 (LTL), from the leaves to the root: row k scaled by its pivot, then removed from
   // the rows of its ancestors (row i = anc(k)[t] spans anc(k)[t+1 ...], the tail of row k)
   for (int k = n - 1; k >= 0; --k) {

@@ -157,7 +157,9 @@ class Controller {
   void integrate();                        ///< stage 3
   /// b = b_a + Σ JᵀBJ at q_k (nv × nv) and its Cholesky factor b = Lᵀ L along the tree of coordinates
   /// (reuse it: b⁻¹x by factor.solveInPlace(x)).
-  const MatrixX& apparentFriction() const { return b_; }
+  /// (dense, built from the assembled pattern when asked: the step itself assembles and factorises b
+  /// on the tree's pattern only)
+  const MatrixX& apparentFriction() const;
   const math::TreeCholesky& apparentFrictionFactor() const { return factor_; }
   const VectorX& qdotFree() const { return qdot_free_; }
   const VectorX& frictionDiagonal() const { return b_a_; }   ///< b_a (nv)
@@ -207,7 +209,13 @@ class Controller {
   VectorX gamma_task_, gamma_level_, gamma_int_, gamma_g_, gamma_c_, gamma_, tmp_;
   MatrixX J_;      // (rows × nv) body Jacobians in priority order
   MatrixX JB_;     // (rows × nv) sqrt(B)·J
-  MatrixX b_;      // (nv × nv)
+  // b on the tree's pattern, packed as factor_ reads it: the diagonal and the entries b_ki (i an
+  // ancestor of k) at factor_.packedIndex(k, i); b_slots_[f]: per frame, for its support columns
+  // a > b (in support order), the packed index of b(cols[a], cols[b]), row by row
+  VectorX b_diag_, b_lower_;
+  std::vector<std::vector<int>> b_slots_;
+  mutable MatrixX b_;      // (nv × nv) dense b, built by apparentFriction() from the packed pattern
+  mutable bool b_stale_ = true;
   // b = Lᵀ L along the model's tree of coordinates (no fill-in: b has the tree's sparsity)
   math::TreeCholesky factor_;
   // J_ is sparse: a frame's rows are zero off its support columns. b_'s Σ JᵀBJ and the projectors'

@@ -35,6 +35,16 @@ class TreeCholesky {
   Eigen::ComputationInfo compute(const Eigen::Ref<const MatrixX>& b);
   Eigen::ComputationInfo info() const { return info_; }
 
+  /// b's entries on the tree's pattern, packed (for callers that assemble b by its pattern only):
+  /// the diagonal b_kk (size()), and the strictly lower entries b_ki, i an ancestor of k, at
+  /// packedIndex(k, i) of a vector of packedSize() entries (row k's ancestors nearest first).
+  int packedSize() const { return static_cast<int>(anc_.size()); }
+  /// Position of b_ki (i an ancestor of k) in the packed lower entries, or −1 when i is not one.
+  int packedIndex(int k, int i) const;
+  /// Same as compute() from the packed pattern (diagonal: size() entries, lower: packedSize()).
+  /// \throws std::invalid_argument on a size mismatch.
+  Eigen::ComputationInfo computePacked(const Eigen::Ref<const VectorX>& diagonal, const Eigen::Ref<const VectorX>& lower);
+
   /// The factor L (lower triangular, b = Lᵀ L) as a dense matrix (tests, logs: it is stored by rows
   /// of ancestors); entries off the tree's pattern are zero.
   MatrixX matrixL() const;
@@ -54,6 +64,7 @@ class TreeCholesky {
   VectorX d_, l_;
   VectorX d_inv_;  // 1 / d_: the solves multiply (a division's latency chains through a solve)
   Eigen::ComputationInfo info_ = Eigen::InvalidInput;
+  Eigen::ComputationInfo factorInPlace();  // d_, l_ hold b's pattern: factorise them
 };
 
 }  // namespace mannequin::math
