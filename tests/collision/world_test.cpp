@@ -324,6 +324,48 @@ TEST(CollisionWorld, AdjacentSegmentsNeverReportedSelfContactsAre) {
   EXPECT_GT(self_contacts, 50);  // self-collision is on and does fire
 }
 
+// Without self collision, one mannequin's segments are not collided with each other (the moving
+// bodies' tree is then not collided with itself at all); a movable body added later is (the query
+// after it rebuilds and collides the moving bodies again).
+TEST(CollisionWorld, WithoutSelfCollisionNoSelfContactsAndAMovableBodyAddedLaterIsSeen) {
+  const auto model = mannequinModel();
+  skeleton::Data data(model);
+  WorldOptions o;
+  o.activation_distance = 0.05;
+  CollisionWorld w(o);
+  MannequinOptions mo;
+  mo.self_collision = false;
+  const int m = w.addMannequin(model, mo);
+  std::mt19937 g(3);
+  ContactSet cs;
+  for (int trial = 0; trial < 50; ++trial) {  // the poses that gave > 50 self contacts with it on
+    math::VectorX q(model.nq);
+    for (int k = 0; k < model.nq; ++k) {
+      const double lo = std::isfinite(model.lower_limit[k]) ? model.lower_limit[k] : -1.0;
+      const double hi = std::isfinite(model.upper_limit[k]) ? model.upper_limit[k] : 1.0;
+      q[k] = std::uniform_real_distribution<double>(lo, hi)(g);
+    }
+    skeleton::forwardKinematics(model, data, q);
+    w.updateMannequin(m, data);
+    w.query(trial, cs);
+    EXPECT_TRUE(cs.contacts.empty()) << "trial " << trial << ": " << cs.contacts.size() << " self contacts";
+  }
+  // a movable box around the right hand: hand–box contacts
+  skeleton::forwardKinematics(model, data, skeleton::standingConfiguration(model));
+  w.updateMannequin(m, data);
+  const int hand = w.findBody("mannequin0/hand_r");
+  const math::Vector3 centre = w.bodyPose(hand).p;
+  const int box = w.addBody("box", {{Shape::box(math::Vector3(0.3, 0.3, 0.3)), SE3()}}, at(centre), BodyKind::kMovable);
+  w.query(100, cs);
+  int hand_box = 0;
+  for (const auto& c : cs.contacts) {
+    EXPECT_TRUE(c.body_a == box || c.body_b == box) << w.bodyName(c.body_a) << " " << w.bodyName(c.body_b);
+    if ((c.body_a == hand && c.body_b == box) || (c.body_a == box && c.body_b == hand)) ++hand_box;
+  }
+  EXPECT_GT(hand_box, 0);
+  expectConsistent(w, cs);
+}
+
 TEST(CollisionWorld, TwoMannequinsCollide) {
   const auto model = mannequinModel();
   skeleton::Data d0(model), d1(model);

@@ -82,6 +82,9 @@ struct CollisionWorld::Impl {
 
   fcl::DynamicAABBTreeCollisionManagerd static_mgr, dynamic_mgr;
   bool dirty = true;  ///< managers must be rebuilt
+  /// Some pair of moving bodies may collide (pairEnabled): else the moving bodies' tree is not
+  /// collided with itself (one mannequin without self collision, no movable object). Set by rebuild().
+  bool dynamic_pairs = true;
 
   std::vector<std::pair<int, int>> candidates;  ///< collider pairs
   detail::NarrowScratch scratch;
@@ -169,6 +172,13 @@ struct CollisionWorld::Impl {
     dynamic_mgr.registerObjects(dyn);
     static_mgr.setup();
     dynamic_mgr.setup();
+    dynamic_pairs = false;
+    const int nb = static_cast<int>(bodies.size());
+    for (int a = 0; a < nb && !dynamic_pairs; ++a) {
+      if (bodies[a].kind == BodyKind::kStatic || bodies[a].colliders.empty()) continue;
+      for (int b = a + 1; b < nb && !dynamic_pairs; ++b)
+        dynamic_pairs = bodies[b].kind != BodyKind::kStatic && !bodies[b].colliders.empty() && pairEnabled(a, b);
+    }
     dirty = false;
   }
 
@@ -415,7 +425,7 @@ void CollisionWorld::query(std::uint64_t step, ContactSet& out) {
   if (any_dynamic) I.dynamic_mgr.update();
   I.candidates.clear();
   I.dynamic_mgr.collide(&I.static_mgr, &I, &Impl::onPair);
-  I.dynamic_mgr.collide(&I, &Impl::onPair);
+  if (I.dynamic_pairs) I.dynamic_mgr.collide(&I, &Impl::onPair);
   // deterministic order whatever the trees' shapes
   std::sort(I.candidates.begin(), I.candidates.end(), [&](const auto& u, const auto& v) {
     const Collider& a0 = I.colliders[u.first];
