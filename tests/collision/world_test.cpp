@@ -287,6 +287,17 @@ TEST(CollisionWorld, StandingMannequinFeetFlatFourPointsEach) {
   expectConsistent(w, cs);
 }
 
+// A configuration uniform within the joint limits (±1 where a coordinate has none).
+math::VectorX randomWithinLimits(const skeleton::Model& model, std::mt19937& g) {
+  math::VectorX q(model.nq);
+  for (int k = 0; k < model.nq; ++k) {
+    const double lo = std::isfinite(model.lower_limit[k]) ? model.lower_limit[k] : -1.0;
+    const double hi = std::isfinite(model.upper_limit[k]) ? model.upper_limit[k] : 1.0;
+    q[k] = std::uniform_real_distribution<double>(lo, hi)(g);
+  }
+  return q;
+}
+
 TEST(CollisionWorld, AdjacentSegmentsNeverReportedSelfContactsAre) {
   const auto model = mannequinModel();
   skeleton::Data data(model);
@@ -305,13 +316,7 @@ TEST(CollisionWorld, AdjacentSegmentsNeverReportedSelfContactsAre) {
   int self_contacts = 0;
   ContactSet cs;
   for (int trial = 0; trial < 200; ++trial) {
-    math::VectorX q(model.nq);
-    for (int k = 0; k < model.nq; ++k) {
-      const double lo = std::isfinite(model.lower_limit[k]) ? model.lower_limit[k] : -1.0;
-      const double hi = std::isfinite(model.upper_limit[k]) ? model.upper_limit[k] : 1.0;
-      q[k] = std::uniform_real_distribution<double>(lo, hi)(g);
-    }
-    skeleton::forwardKinematics(model, data, q);
+    skeleton::forwardKinematics(model, data, randomWithinLimits(model, g));
     w.updateMannequin(m, data);
     w.query(trial, cs);
     for (const auto& c : cs.contacts) {
@@ -339,13 +344,7 @@ TEST(CollisionWorld, WithoutSelfCollisionNoSelfContactsAndAMovableBodyAddedLater
   std::mt19937 g(3);
   ContactSet cs;
   for (int trial = 0; trial < 50; ++trial) {  // the poses that gave > 50 self contacts with it on
-    math::VectorX q(model.nq);
-    for (int k = 0; k < model.nq; ++k) {
-      const double lo = std::isfinite(model.lower_limit[k]) ? model.lower_limit[k] : -1.0;
-      const double hi = std::isfinite(model.upper_limit[k]) ? model.upper_limit[k] : 1.0;
-      q[k] = std::uniform_real_distribution<double>(lo, hi)(g);
-    }
-    skeleton::forwardKinematics(model, data, q);
+    skeleton::forwardKinematics(model, data, randomWithinLimits(model, g));
     w.updateMannequin(m, data);
     w.query(trial, cs);
     EXPECT_TRUE(cs.contacts.empty()) << "trial " << trial << ": " << cs.contacts.size() << " self contacts";
