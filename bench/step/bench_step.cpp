@@ -21,6 +21,8 @@
 // Counters: contacts (mean contact rows per step, measured), active (λ > 0), lcp (LCP size), pivots,
 // warm (share of the LCP solves the warm start answered, 0 pivots),
 // per-stage µs (collision, constraints = rows + assemble + lcp, integrate), max_pen_mm, lcp_failures, failed_steps.
+// With libmujoco-dev: BM_MujocoStep/contacts:N and BM_MujocoTrackingStep/contacts:N, the same scene in MuJoCo
+// at our settled pose (equal contact counts), bare or following the same six targets (see mujocoSweep).
 #include <benchmark/benchmark.h>
 
 #include <cmath>
@@ -489,21 +491,29 @@ void handsOnTable(benchmark::State& state) {
 namespace {
 
 /// The contact sweep's scene in MuJoCo: the mannequin exported by skeleton::toMjcf (same joints, masses,
-/// capsules, box feet; gravity 0 as the sweep), the floor and the same spheres as static geoms, with
-/// margin = 2 cm (our activation distance): MuJoCo keeps the contacts within 2 cm, all in its solver (no
-/// gap). Spheres frictionless (condim 1, priority 1 so that their condim wins over the mannequin's 3) as
-/// ours; the floor with friction 0.5 (pyramidal cones: 4 rows per contact, MuJoCo's default). MuJoCo's
-/// defaults otherwise: Euler, Newton solver. No controller: MuJoCo's soft contacts push from the margin
-/// on (ours: λ = 0 until touching) and nothing holds the mannequin, so it would drift out of range; each
-/// step starts from one fixed state (qpos reset, qvel 0: a copy of 51 + 43 doubles, timed with the step).
-/// That state is our World's, settled: our World steps first (warm-up, 300 steps: the contacts push the
-/// standing mannequin a little, some of the scene's contacts leave the 2 cm range and others enter), then
-/// MuJoCo starts every step from our configuration at that moment (mjcfQpos), so both engines see the
-/// same pose in the same scene: the same contact count, up to their contact generation (the counters
-/// `contacts` and `ours_contacts` say it; the goal compares at equal contact count). Times mj_step;
-/// after the run, times our World (continuing) over as many steps with a steady clock and reports:
-/// contacts (MuJoCo's d->ncon, mean), efc (its constraint rows), ours_contacts (our contact rows, mean),
-/// ours_us, mujoco_us and ratio = ours_us / mujoco_us.
+/// capsules, box feet; gravity 0 as the sweep), the floor and the same spheres as static geoms. Contacts
+/// in the same range as ours: our pairs become rows within the activation distance (2 cm) of the
+/// segments' margin shells (5 mm; the scene has none), so MuJoCo's geom margin is 2.5 cm on the real
+/// geometry, all its contacts in its solver (no gap). Spheres frictionless (condim 1, priority 1 so that
+/// their condim wins over the mannequin's 3) as ours; the floor with friction 0.5 (pyramidal cones: 4 rows
+/// per contact, MuJoCo's default). MuJoCo's defaults otherwise: Euler, Newton solver.
+///
+/// The same pose: our World steps first (warm-up, 300 steps: the contacts push the standing mannequin a
+/// little, some of the scene's contacts leave the range and others enter), then every MuJoCo step starts
+/// from our configuration at that moment (mjcfQpos; qvel 0: a copy of 51 + 43 doubles, timed with the
+/// step). MuJoCo's soft contacts push from the margin on (ours: λ = 0 until touching) and, without
+/// tracking, nothing holds its mannequin, so it would drift out of range: hence the reset. Both engines
+/// then count the same contacts (counters `contacts` and `ours_contacts`): the goal compares at equal
+/// contact count.
+///
+/// `tracking` (BM_MujocoTrackingStep): MuJoCo does our step's job too — the six frames (kBodies) follow
+/// six mocap targets, MuJoCo's way: a mocap body per target, welded (relpose identity) to the body of the
+/// joint carrying the frame, each target where its body is in the reset state (the welds start every step
+/// with zero violation, checked: the case fails otherwise). 36 equality rows for our 36 task rows.
+///
+/// Times mj_step; then times our World (continuing) over as many steps (at least 200) with a steady clock
+/// and reports: contacts (MuJoCo's d->ncon, mean), efc (its constraint rows), ours_contacts (our contact
+/// rows, mean), ours_us, mujoco_us and ratio = ours_us / mujoco_us.
 void mujocoSweep(benchmark::State& state, int target, bool tracking) {
   // MuJoCo prints warnings on stdout (and appends them to MUJOCO_LOG.TXT): stderr keeps the JSON valid
   mju_user_warning = [](const char* msg) { std::fprintf(stderr, "bench-step: MuJoCo warning: %s\n", msg); };
@@ -586,6 +596,16 @@ void mujocoSweep(benchmark::State& state, int target, bool tracking) {
       const int mc = m->body_mocapid[t];
       for (int c = 0; c < 3; ++c) d->mocap_pos[3 * mc + c] = d->xpos[3 * b + c];
       for (int c = 0; c < 4; ++c) d->mocap_quat[4 * mc + c] = d->xquat[4 * b + c];
+    }
+    mj_forward(m, d);  // the welds' violation in the reset state: none
+    double violation = 0;
+    for (int i = 0; i < d->nefc; ++i)
+      if (d->efc_type[i] == mjCNSTR_EQUALITY) violation = std::max(violation, std::abs(d->efc_pos[i]));
+    if (violation > 1e-9) {
+      state.SkipWithError(("MuJoCo's welds start violated by " + std::to_string(violation) + " (expected 0)").c_str());
+      mj_deleteData(d);
+      mj_deleteModel(m);
+      return;
     }
   }
   for (int i = 0; i < 100; ++i) {  // warm-up, as ours
