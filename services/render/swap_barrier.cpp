@@ -75,8 +75,11 @@ std::optional<std::uint64_t> SwapBarrier::awaitLeader(std::uint64_t after, const
   std::optional<Clock::time_point> deadline;
   while (!stopping_()) {
     if (leader() != l) return std::nullopt;  // a smaller name came back or joined
+    // the leader's post, or a peer's: a follower posts only the step it draws for its leader, so a peer's
+    // newer post relays the leader's (a leader killed while sending its post may reach one survivor only)
+    // or is the step of a peer that found the leader dead first and leads now
+    if (const std::uint64_t f = newestPost(); f > after) return f;
     const Peer& p = peers_.at(l);
-    if (p.frame > after) return p.frame;
     if (!deadline && have_newer()) deadline = Clock::now() + timeout_;
     // dead: a newer state waits here for the timeout and nothing at all came from the leader meanwhile
     if (deadline && Clock::now() >= *deadline && Clock::now() - p.heard >= timeout_) {
@@ -95,12 +98,27 @@ std::optional<std::uint64_t> SwapBarrier::awaitLeader(std::uint64_t after, const
 int SwapBarrier::arriveAndWait(std::uint64_t frame) {
   post(frame);
   const auto deadline = Clock::now() + timeout_;
+  const std::string l = leader();
   for (;;) {
+    const auto now = Clock::now();
     bool all = true;
-    for (const auto& [n, p] : peers_)
-      if (!p.dropped && p.frame < frame) all = false;
+    for (auto& [n, p] : peers_) {
+      if (p.dropped || p.frame >= frame) continue;
+      if (n == l && now - p.heard >= timeout_) {
+        // the leader posts a step before its followers draw it: a leader that has not posted this one took
+        // no part in it (this node drew a peer's relay of its last post, or the step of a peer that found it
+        // dead); silent for the timeout besides, it is dead, as in awaitLeader: not waited for a whole
+        // timeout more, while the peer that leads now waits for this node
+        p.dropped = true;
+        ++drops_;
+        spdlog::warn("swap barrier: leader '{}' silent for {} ms, not at frame {} (a peer's post); dropped", n,
+                     std::chrono::duration_cast<std::chrono::milliseconds>(timeout_).count(), frame);
+        continue;
+      }
+      all = false;
+    }
     if (all || stopping_()) break;
-    if (Clock::now() >= deadline) {
+    if (now >= deadline) {
       for (auto& [n, p] : peers_)
         if (!p.dropped && p.frame < frame) {
           p.dropped = true;
@@ -110,9 +128,17 @@ int SwapBarrier::arriveAndWait(std::uint64_t frame) {
         }
       break;
     }
+    keepAlive(frame);
     poll_(std::chrono::milliseconds(1));
   }
   return peers();
+}
+
+std::uint64_t SwapBarrier::newestPost() const {
+  std::uint64_t f = 0;
+  for (const auto& [n, p] : peers_)
+    if (!p.dropped) f = std::max(f, p.frame);
+  return f;
 }
 
 }  // namespace mannequin::render_node

@@ -5,11 +5,18 @@
 /// name} on its own publisher and subscribes to its peers' (the deployment's `connect`).
 ///
 /// Per frame: the leader (the smallest name among this node and the peers not dropped) draws its newest
-/// state and posts its step f; a follower waits for the leader's post of a step newer than its last
-/// one, draws that step and posts it; then every node waits until every peer not dropped has posted a
+/// state and posts its step f; a follower waits for a post of a step newer than its last one, by the
+/// leader or by a peer (a follower posts only the leader's steps, so a peer's post relays the leader's),
+/// draws that step and posts it; then every node waits until every peer not dropped has posted a
 /// step >= f, and swaps. A peer that does not answer within the timeout is dropped (not waited for)
-/// until it posts again; a leader that posts nothing at all (not even its keep-alive, see keepAlive())
-/// for the timeout while this node has a newer state is dropped too (the next name leads). A node that joins late is waited for from its first post.
+/// until it posts again; so is a leader that posts nothing at all (every waiting node re-posts as a
+/// keep-alive, see keepAlive()) for the timeout while this node has a newer state, or while this node
+/// waits in the barrier of a step that leader did not post (the next name leads). A node that joins late
+/// is waited for from its first post.
+///
+/// A leader killed while sending its post may reach only some followers: they draw that step and post
+/// it, which relays it to the others, so the survivors still swap the same step; then the first survivor
+/// that finds the leader silent for the timeout leads, and the others take its post at once.
 #include <chrono>
 #include <cstdint>
 #include <functional>
@@ -35,15 +42,19 @@ class SwapBarrier {
   void greet();
   bool isLeader() const { return leader() == name_; }
   std::string leader() const;
-  /// Follower: the leader's newest posted step > `after`; nullopt when the leader changed (this node may
+  /// Follower: the newest step > `after` posted by the leader or by a peer not dropped (a relay of the
+  /// leader's, or the post of a peer that already leads); nullopt when the leader changed (this node may
   /// lead now), it was dropped (no post within the timeout while `have_newer()`), or on stop.
   std::optional<std::uint64_t> awaitLeader(std::uint64_t after, const std::function<bool()>& have_newer);
   /// Posts `frame` (drawn) and waits until every peer not dropped posted >= frame, or the timeout (the
-  /// late ones are dropped). Returns the number of peers that made it.
+  /// late ones are dropped); the leader, when it did not post `frame` (this node drew a peer's post) and
+  /// nothing at all came from it for the timeout, is dropped at once. Re-posts `frame` every timeout/4
+  /// while waiting. Returns the number of peers that made it.
   int arriveAndWait(std::uint64_t frame);
   int peers() const;  ///< peers not dropped
-  /// While waiting (for a leader or a new state): re-posts `frame` (the last one swapped) at most every
-  /// timeout/4, so peers see this node alive and do not take it for dead.
+  /// While waiting (for a leader, a new state or the barrier): re-posts `frame` (the last one swapped, or
+  /// in the barrier the one arrived at) at most every timeout/4, so peers see this node alive and do not
+  /// take it for dead.
   void keepAlive(std::uint64_t frame);
   std::uint64_t dropped() const { return drops_; }
 
@@ -54,6 +65,7 @@ class SwapBarrier {
     std::chrono::steady_clock::time_point heard;
   };
   void post(std::uint64_t frame);
+  std::uint64_t newestPost() const;  ///< the newest step posted by a peer not dropped (0: none)
   transport::Publisher& pub_;
   std::string name_;
   std::chrono::nanoseconds timeout_;
