@@ -8,21 +8,21 @@
 
 namespace mannequin::render_node {
 
-using Clock = std::chrono::steady_clock;
-
 SwapBarrier::SwapBarrier(transport::Publisher& publisher, std::string name, double timeout_s,
-                         std::function<void(std::chrono::microseconds)> poll, std::function<bool()> stopping)
+                         std::function<void(std::chrono::microseconds)> poll, std::function<bool()> stopping,
+                         std::function<Clock::time_point()> now)
     : pub_(publisher),
       name_(std::move(name)),
       timeout_(std::chrono::nanoseconds(static_cast<std::int64_t>(timeout_s * 1e9))),
       poll_(std::move(poll)),
-      stopping_(std::move(stopping)) {}
+      stopping_(std::move(stopping)),
+      now_(now ? std::move(now) : std::function<Clock::time_point()>([] { return Clock::now(); })) {}
 
 void SwapBarrier::onMessage(const v1::RenderSync& m) {
   if (m.node() == name_) return;
   auto [it, fresh] = peers_.try_emplace(m.node());
   Peer& p = it->second;
-  p.heard = Clock::now();
+  p.heard = now_();
   if (fresh) spdlog::info("swap barrier: peer '{}' joined", m.node());
   if (p.dropped && (m.frame() > p.frame || fresh)) {
     p.dropped = false;
@@ -37,18 +37,18 @@ void SwapBarrier::post(std::uint64_t frame) {
   m.set_node(name_);
   pub_.publish(transport::topics::kRenderSync, m);
   pub_.poll();
-  last_post_ = Clock::now();
+  last_post_ = now_();
 }
 
 void SwapBarrier::keepAlive(std::uint64_t frame) {
-  if (Clock::now() - last_post_ >= timeout_ / 4) post(frame);
+  if (now_() - last_post_ >= timeout_ / 4) post(frame);
 }
 
 void SwapBarrier::greet() {
-  const auto end = Clock::now() + std::max<std::chrono::nanoseconds>(timeout_, std::chrono::seconds(2));
-  auto next = Clock::now();
-  while (Clock::now() < end && !stopping_()) {
-    if (Clock::now() >= next) {
+  const auto end = now_() + std::max<std::chrono::nanoseconds>(timeout_, std::chrono::seconds(2));
+  auto next = now_();
+  while (now_() < end && !stopping_()) {
+    if (now_() >= next) {
       post(0);
       next += std::chrono::milliseconds(50);
     }
@@ -80,9 +80,9 @@ std::optional<std::uint64_t> SwapBarrier::awaitLeader(std::uint64_t after, const
     // or is the step of a peer that found the leader dead first and leads now
     if (const std::uint64_t f = newestPost(); f > after) return f;
     const Peer& p = peers_.at(l);
-    if (!deadline && have_newer()) deadline = Clock::now() + timeout_;
+    if (!deadline && have_newer()) deadline = now_() + timeout_;
     // dead: a newer state waits here for the timeout and nothing at all came from the leader meanwhile
-    if (deadline && Clock::now() >= *deadline && Clock::now() - p.heard >= timeout_) {
+    if (deadline && now_() >= *deadline && now_() - p.heard >= timeout_) {
       peers_.at(l).dropped = true;
       ++drops_;
       spdlog::warn("swap barrier: leader '{}' silent for {} ms; dropped", l,
@@ -97,10 +97,10 @@ std::optional<std::uint64_t> SwapBarrier::awaitLeader(std::uint64_t after, const
 
 int SwapBarrier::arriveAndWait(std::uint64_t frame) {
   post(frame);
-  const auto deadline = Clock::now() + timeout_;
+  const auto deadline = now_() + timeout_;
   const std::string l = leader();
   for (;;) {
-    const auto now = Clock::now();
+    const auto now = now_();
     bool all = true;
     for (auto& [n, p] : peers_) {
       if (p.dropped || p.frame >= frame) continue;

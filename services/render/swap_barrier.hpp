@@ -30,10 +30,13 @@ namespace mannequin::render_node {
 
 class SwapBarrier {
  public:
+  using Clock = std::chrono::steady_clock;
   /// `poll(timeout)` waits up to timeout for traffic (delivering render.sync to onMessage); `stopping()`
-  /// ends the waits early.
+  /// ends the waits early; `now()` is the clock the timeouts are measured on (steady_clock when empty; a
+  /// test's scripted poll advances its own instead of waiting).
   SwapBarrier(transport::Publisher& publisher, std::string name, double timeout_s,
-              std::function<void(std::chrono::microseconds)> poll, std::function<bool()> stopping);
+              std::function<void(std::chrono::microseconds)> poll, std::function<bool()> stopping,
+              std::function<Clock::time_point()> now = {});
 
   /// Handler of render.sync (own messages are ignored).
   void onMessage(const v1::RenderSync& m);
@@ -62,7 +65,7 @@ class SwapBarrier {
   struct Peer {
     std::uint64_t frame = 0;
     bool dropped = false;
-    std::chrono::steady_clock::time_point heard;
+    Clock::time_point heard;
   };
   void post(std::uint64_t frame);
   std::uint64_t newestPost() const;  ///< the newest step posted by a peer not dropped (0: none)
@@ -71,9 +74,10 @@ class SwapBarrier {
   std::chrono::nanoseconds timeout_;
   std::function<void(std::chrono::microseconds)> poll_;
   std::function<bool()> stopping_;
+  std::function<Clock::time_point()> now_;
   std::map<std::string, Peer> peers_;
   std::uint64_t drops_ = 0;
-  std::chrono::steady_clock::time_point last_post_;
+  Clock::time_point last_post_;
 };
 
 }  // namespace mannequin::render_node

@@ -326,7 +326,8 @@ TEST_F(RenderTool, TheLauncherRunsARenderNodeLikeAnyService) {
 }
 
 // The swap barrier alone (services/render/swap_barrier.cpp): node wall_b between the leader wall_a and
-// wall_c, its peers' posts handed to it by a scripted poll (one per call), timeout 0.2 s.
+// wall_c, its peers' posts handed to it by a scripted poll (one per call), timeout 0.2 s on a scripted
+// clock: a poll without traffic advances it by the poll's wait, so no real time passes.
 class SwapBarrierScript {
  public:
   explicit SwapBarrierScript(const std::string& name)
@@ -335,9 +336,9 @@ class SwapBarrierScript {
             pub_, name, 0.2,
             [this](std::chrono::microseconds t) {
               if (next_ < script_.size()) barrier_.onMessage(script_[next_++]);
-              else std::this_thread::sleep_for(t);  // the poll's wait for traffic (none comes)
+              else now_ += t;  // the poll's wait for traffic (none comes)
             },
-            [] { return false; }) {}
+            [] { return false; }, [this] { return now_; }) {}
   static v1::RenderSync post(const std::string& node, std::uint64_t frame) {
     v1::RenderSync m;
     m.set_node(node);
@@ -353,6 +354,7 @@ class SwapBarrierScript {
   transport::Publisher pub_;
   std::vector<v1::RenderSync> script_;
   std::size_t next_ = 0;
+  render_node::SwapBarrier::Clock::time_point now_{};  // the scripted clock
   render_node::SwapBarrier barrier_;
 };
 
