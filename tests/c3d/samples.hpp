@@ -5,12 +5,11 @@
 #include <cstdlib>
 #include <string>
 
+#include "../common/source.hpp"
+
 namespace c3dtest {
 
-inline std::string sourceDir() {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return root ? root : ".";
-}
+using mannequin::testing::sourceDir;
 
 /// kind: "pr" (PC/Intel), "sr" (SGI/MIPS), "vr" (DEC/VAX).
 inline std::string samplePath(const std::string& kind) {

@@ -17,16 +17,13 @@
 #include "mannequin/constraints/system.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
+#include "../common/mannequins.hpp"
 
 using namespace mannequin;
 using namespace mannequin::constraints;
 
 namespace {
-const skeleton::Model& male50() {
-  static const skeleton::Model m =
-      skeleton::buildMannequin(skeleton::loadMannequinSpec("configs/mannequins/male_50th.yaml"));
-  return m;
-}
+using mannequin::testing::male50;
 
 control::ControlFrameConfig frame(const std::string& name, int priority, double k_rot, double k_lin) {
   control::ControlFrameConfig c;

@@ -11,17 +11,14 @@
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 #include "../common/alloc_counter.hpp"
+#include "../common/mannequins.hpp"
 
 using namespace mannequin;
 using namespace mannequin::constraints;
 using Eigen::Vector2d;
 
 namespace {
-const skeleton::Model& male50() {
-  static const skeleton::Model m =
-      skeleton::buildMannequin(skeleton::loadMannequinSpec("configs/mannequins/male_50th.yaml"));
-  return m;
-}
+using mannequin::testing::male50;
 
 /// A 0.4 m square centred at (1, 2) on the floor z = 0, with interior and mid-edge points that the
 /// hull must drop.

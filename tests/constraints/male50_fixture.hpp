@@ -8,12 +8,11 @@
 #include "mannequin/control/config.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
+#include "../common/mannequins.hpp"
+
 namespace mannequin::testing_fixture {
 
-inline const skeleton::Model& male50() {
-  static const skeleton::Model m = skeleton::buildMannequin(skeleton::loadMannequinSpec("configs/mannequins/male_50th.yaml"));
-  return m;
-}
+using mannequin::testing::male50;
 
 inline int coordinate(const std::string& name) {
   const auto names = male50().coordinateNames();

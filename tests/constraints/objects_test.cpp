@@ -97,9 +97,10 @@ class TestHand final : public cs::ConstrainedSystem, public cs::BodyFrames {
   int nv() const override { return 6; }
   const Eigen::VectorXd& qdotFree() const override { return qdot_free_; }
   const mannequin::math::TreeCholesky& frictionFactor() const override { return factor_; }
-  void applyConstraintForce(const Eigen::VectorXd& g) override {
+  bool applyConstraintForce(const Eigen::VectorXd& g) override {
     gamma_ = g;
     qdot_ += b_.diagonal().cwiseInverse().cwiseProduct(g);
+    return true;
   }
   const SE3& pose(int) const override { return pose_; }
   void pointJacobian(int, const Vector3& p, Eigen::Ref<Eigen::Matrix3Xd> J) const override {

@@ -7,18 +7,12 @@
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 
+#include "../common/mannequins.hpp"
+
 namespace mannequin::control::testing {
 
-inline std::string sourceDir() {
-  const char* env = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return env ? std::string(env) : std::string(".");
-}
-
-inline const skeleton::Model& male50() {
-  static const skeleton::Model model =
-      skeleton::buildMannequin(skeleton::loadMannequinSpec(sourceDir() + "/configs/mannequins/male_50th.yaml"));
-  return model;
-}
+using mannequin::testing::male50;
+using mannequin::testing::sourceDir;
 
 inline Vector6 gains(double rot, double lin) {
   Vector6 g;

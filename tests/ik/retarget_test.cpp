@@ -9,14 +9,12 @@
 #include "mannequin/ik/retarget.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/bvh_write.hpp"
+#include "../common/source.hpp"
 
 namespace mannequin::ik {
 namespace {
 
-std::string sourceDir() {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return root ? root : ".";
-}
+using mannequin::testing::sourceDir;
 Model mannequin(const std::string& name) {
   return skeleton::buildMannequin(skeleton::loadMannequinSpec(sourceDir() + "/configs/mannequins/" + name + ".yaml"));
 }

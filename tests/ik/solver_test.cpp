@@ -12,6 +12,7 @@
 #include "mannequin/math/so3.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "test_models.hpp"
+#include "../common/source.hpp"
 
 namespace mannequin::ik {
 namespace {
@@ -19,10 +20,7 @@ namespace {
 using skeleton::JointType;
 namespace tm = skeleton::test_models;
 
-std::string sourceDir() {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return root ? root : ".";
-}
+using mannequin::testing::sourceDir;
 
 /// A serial chain of revolute joints with random axes (fixed base), a frame at the tip.
 Model makeChain(unsigned seed, int n, double limit = 0.0) {

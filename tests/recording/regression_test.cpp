@@ -31,6 +31,7 @@
 #include <mannequin/v1/world.pb.h>
 #include "../common/child_process.hpp"
 #include "test_files.hpp"
+#include "../common/source.hpp"
 
 namespace fs = std::filesystem;
 using namespace mannequin::recording;
@@ -40,10 +41,7 @@ namespace {
 
 fs::path binDir() { return fs::read_symlink("/proc/self/exe").parent_path().parent_path(); }
 
-std::string sourceDir() {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return root ? root : ".";
-}
+using mannequin::testing::sourceDir;
 
 using namespace std::chrono_literals;
 

@@ -1,13 +1,10 @@
 #pragma once
-#include <cstdlib>
 #include <string>
+
+#include "../common/source.hpp"
 
 namespace scenario_test {
 
-// the checkout (tests run there; MANNEQUIN_SOURCE_DIR when set)
-inline std::string sourceDir() {
-  const char* d = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return d != nullptr ? d : ".";
-}
+using mannequin::testing::sourceDir;
 
 }  // namespace scenario_test

@@ -120,7 +120,8 @@ lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
     rows_.push_back({c.q, upper, upper ? c.upper - q(c.q) : q(c.q) - c.lower, res.z(static_cast<Eigen::Index>(r))});
   }
   gamma_.noalias() = Jc_.transpose() * res.z;
-  ctl.applyConstraintForce(gamma_);
+  // refused (a non-finite torque): the free motion stays, and the status says the limits did not act
+  if (ctl.applyConstraintForce(gamma_) != control::ForceStatus::kOk) return lcp::LcpStatus::NumericalFailure;
   return res.status;
 }
 

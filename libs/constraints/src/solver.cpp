@@ -595,7 +595,7 @@ const SolveReport& ConstraintSolver::solve(double dt) {
       if (!((touched >> s) & 1u)) continue;
       const auto us = static_cast<std::size_t>(s);
       im.gamma[us].noalias() = im.Rt[us].leftCols(nz) * z;
-      systems_[us]->applyConstraintForce(im.gamma[us]);
+      if (!systems_[us]->applyConstraintForce(im.gamma[us])) ++rep.refused_forces;  // that system keeps its free motion
     }
   }
   for (int r = 0; r < nr; ++r) {

@@ -1,5 +1,7 @@
 #include "mannequin/control/controller.hpp"
 
+#include "mannequin/core/check.hpp"
+
 #include <spdlog/spdlog.h>
 
 #include <Eigen/Eigenvalues>
@@ -251,16 +253,15 @@ void Controller::reset(const VectorX& q0) {
   free_motion_ready_ = false;
 }
 
-void Controller::setTarget(int i, const SE3& oMd) { setTarget(i, oMd, Vector6::Zero()); }
+TargetStatus Controller::setTarget(int i, const SE3& oMd) { return setTarget(i, oMd, Vector6::Zero()); }
 
-void Controller::setTarget(int i, const SE3& oMd, const Vector6& target_twist) {
+TargetStatus Controller::setTarget(int i, const SE3& oMd, const Vector6& target_twist) {
   checkFrame(i);
-  if (!oMd.allFinite() || !target_twist.allFinite())
-    throw std::invalid_argument(describe(i) + ": target has non-finite values (previous target kept)");
-  if (!math::isRotation(oMd.R, 1e-6))
-    throw std::invalid_argument(describe(i) + ": target rotation is not a rotation matrix (previous target kept)");
+  if (!oMd.allFinite() || !target_twist.allFinite()) return TargetStatus::kNonFinite;  // previous target kept
+  if (!math::isRotation(oMd.R, 1e-6)) return TargetStatus::kNotRotation;
   frames_[i].target = oMd;
   frames_[i].target_twist = target_twist;
+  return TargetStatus::kOk;
 }
 
 void Controller::setFrameEnabled(int i, bool enabled) {
@@ -554,16 +555,16 @@ StepStatus Controller::computeFreeMotion() {
   return StepStatus::kOk;
 }
 
-void Controller::applyConstraintForce(const VectorX& gamma_c) {
-  if (gamma_c.size() != nv_)
-    throw std::invalid_argument("applyConstraintForce: size " + std::to_string(gamma_c.size()) + ", expected " + std::to_string(nv_));
-  if (!gamma_c.allFinite()) throw std::invalid_argument("applyConstraintForce: non-finite constraint torque (ignored)");
-  if (!free_motion_ready_) throw std::invalid_argument("applyConstraintForce: call computeFreeMotion() first");
+ForceStatus Controller::applyConstraintForce(const VectorX& gamma_c) {
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(gamma_c.size(), nv_, "constraint torque gamma_c");
+  if (!gamma_c.allFinite()) return ForceStatus::kNonFinite;
+  if (!free_motion_ready_) return ForceStatus::kNoFreeMotion;
   // q̇ = q̇_free + b⁻¹ J_cᵀ W_c (Alg. 4)
   tmp_ = gamma_c;
   factor_.solveInPlace(tmp_);
   qdot_ += tmp_;
   gamma_c_ += gamma_c;
+  return ForceStatus::kOk;
 }
 
 void Controller::integrate() {

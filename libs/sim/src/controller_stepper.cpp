@@ -67,11 +67,8 @@ void ControllerStepper::setTarget(int i, const math::SE3& oMd, const math::Vecto
     controller_->setFrameEnabled(d.index, w > 0.0);
     d.weight = w;
   }
-  try {
-    controller_->setTarget(d.index, oMd * d.offset, math::actTwist(d.offset_inv, V_d));
-  } catch (const std::invalid_argument&) {
-    // not a rotation: the previous target stays (the controller keeps it)
-  }
+  // not a rotation: refused, the previous target stays (the controller keeps it)
+  (void)controller_->setTarget(d.index, oMd * d.offset, math::actTwist(d.offset_inv, V_d));
 }
 
 void ControllerStepper::setGains(int i, const math::Vector6* stiffness, const math::Vector6* damping) {

@@ -72,8 +72,10 @@ void RigidObject::computeFreeMotion(const Vector3& gravity, double /*dt*/) {
   qdot_ = qdot_free_;
 }
 
-void RigidObject::applyConstraintForce(const Eigen::VectorXd& gamma_c) {
+bool RigidObject::applyConstraintForce(const Eigen::VectorXd& gamma_c) {
+  if (gamma_c.size() != qdot_.size() || !gamma_c.allFinite()) return false;  // refused: ν stays
   qdot_ += b_inv_.cwiseProduct(gamma_c);
+  return true;
 }
 
 void RigidObject::integrate(double dt) {

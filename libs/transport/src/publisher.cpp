@@ -76,12 +76,16 @@ Publisher::TopicState& Publisher::state(std::string_view topic) {
   return topics_.emplace(std::string(topic), std::move(s)).first->second;
 }
 
+void stampHeader(v1::Header& header, std::uint64_t sequence, const std::string& source, std::int64_t send_time_ns) {
+  header.set_schema_version(kSchemaVersion);
+  header.set_sequence(sequence);
+  header.set_source(source);
+  header.set_send_time_ns(send_time_ns);
+}
+
 void Publisher::fillHeader(std::string_view topic, v1::Header& header) {
   TopicState& s = state(topic);
-  header.set_schema_version(kSchemaVersion);
-  header.set_sequence(++s.sequence);
-  header.set_source(options_.source);
-  header.set_send_time_ns(options_.deterministic ? 0 : wallNs());
+  stampHeader(header, ++s.sequence, options_.source, options_.deterministic ? 0 : wallNs());
 }
 
 void Publisher::send(std::string_view topic, std::string_view payload) {

@@ -20,8 +20,10 @@
 #include "mannequin/proto/schema.hpp"
 #include "mannequin/recording/mcap_reader.hpp"
 #include "mannequin/recording/mcap_writer.hpp"
+#include "mannequin/sim/step_driver.hpp"
 #include "mannequin/simservice/messages.hpp"
 #include "mannequin/transport/convert.hpp"
+#include "mannequin/transport/publisher.hpp"
 #include "mannequin/transport/topics.hpp"
 #include "mannequin/transport/validate.hpp"
 #include "mannequin/v1/mocap.pb.h"
@@ -29,58 +31,6 @@
 namespace mannequin::simservice {
 
 namespace {
-
-bool startsWith(const std::string& s, const char* prefix) { return s.rfind(prefix, 0) == 0; }
-
-bool endsWith(std::string s, const std::string& suffix) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
-}
-
-/// After each step: the diagnostics into the summary (no allocation).
-void accumulate(const sim::World& world, bool ok, OfflineSummary& s) {
-  ++s.steps;
-  const sim::StepDiagnostics& d = world.diagnostics();
-  if (!ok || d.nan) ++s.nan_steps;
-  if (world.physics()) {
-    s.max_penetration_m = std::max(s.max_penetration_m, d.max_penetration_m);
-    s.max_contacts = std::max(s.max_contacts, d.contacts);
-    s.contact_sum += d.contacts;
-  }
-  bool foot = false;
-  for (int m = 0; m < world.numMannequins(); ++m) {
-    if (world.physics()) {
-      const sim::MannequinDiagnostics& md = world.mannequinDiagnostics(m);
-      foot = foot || md.foot_contact;
-      if (std::isfinite(md.balance_distance_m) &&
-          (!std::isfinite(s.min_balance_distance_m) || md.balance_distance_m < s.min_balance_distance_m))
-        s.min_balance_distance_m = md.balance_distance_m;
-      s.worst_joint_limit_excess_rad = std::max(s.worst_joint_limit_excess_rad, md.worst_joint_limit_excess_rad);
-      ++s.mannequin_steps;
-      if (md.balance_driving) {
-        ++s.balance_driving_steps;
-        if (md.balance_margin_fraction >= 1.0) ++s.balance_full_margin_steps;
-      }
-      if (std::isfinite(md.force_margin_n)) {
-        if (!(md.force_margin_n >= s.min_force_margin_n)) s.min_force_margin_n = md.force_margin_n;  // NaN: the first
-        s.force_margin_sum += md.force_margin_n;
-        ++s.force_margin_samples;
-      }
-    }
-    if (!world.calibrated(m)) continue;
-    for (const sim::DrivenFrame& f : world.controlFrames(m)) {
-      if (!f.tracked) continue;
-      if (startsWith(f.frame, "hand_")) {
-        s.hand_error_sum += f.position_error;
-        ++s.hand_samples;
-      } else if (startsWith(f.frame, "foot_")) {
-        s.foot_error_sum += f.position_error;
-        ++s.foot_samples;
-      }
-    }
-  }
-  if (foot) ++s.foot_contact_steps;
-}
 
 /// A progress bar with ETA on stderr, redrawn at most every 0.1 s.
 class Progress {
@@ -341,6 +291,7 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
   sim::World& world = *world_;
   const SimServiceConfig& config = config_;
   OfflineSummary s;
+  s.reset(world.numMannequins());
   s.physics = world.physics();
   s.balance_controller = world.physics() && world.config().physics.balance_controller.enabled;
   for (int m = 0; m < world.numMannequins(); ++m) s.ergonomics.push_back({world.name(m)});
@@ -372,15 +323,13 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
     if (!writer || !tick.publish) return;
     toScenarioState(e, world.time(), state_msg);
     v1::Header* h = state_msg.mutable_header();
-    h->set_schema_version(transport::kSchemaVersion);
-    h->set_sequence(++state_seq);
-    h->set_source(config.name);
+    transport::stampHeader(*h, ++state_seq, config.name, 0);
     state_msg.SerializeToString(&payload);
     const auto t = static_cast<recording::Timestamp>(h->stamp_ns());
     writer->write(state_channel, state_seq, t, t, payload);
   };
   v1::WorldState msg;
-  double world_phase = 0.0;
+  sim::RateDivider world_rate(config.world_rate, config.world.step);
   std::vector<ergonomics::Assessment> assessments(static_cast<std::size_t>(world.numMannequins()));
   std::vector<const ergonomics::Assessment*> sampled(static_cast<std::size_t>(world.numMannequins()), nullptr);
   const double dt = 1.0 / config.world_rate;
@@ -423,31 +372,43 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
     }
   };
   const auto publish = [&] {
-    world_phase += config.world_rate * config.world.step;
-    if (world_phase < 1.0 - 1e-9) return;
-    world_phase -= 1.0;
+    if (!world_rate.tick()) return;
     sampleErgonomics();
     if (on_sample) on_sample(world, sampled);
     if (!writer) return;
     toWorldState(world, nullptr, false, true, msg);
     v1::Header* h = msg.mutable_header();
-    h->set_schema_version(transport::kSchemaVersion);
-    h->set_sequence(static_cast<std::uint64_t>(++s.worlds));
-    h->set_source(config.name);
-    h->set_send_time_ns(0);  // deterministic
+    transport::stampHeader(*h, static_cast<std::uint64_t>(++s.worlds), config.name, 0);  // send time 0: deterministic
     msg.SerializeToString(&payload);
     const auto t = static_cast<recording::Timestamp>(h->stamp_ns());
     writer->write(channel, static_cast<std::uint32_t>(s.worlds), t, t, payload);
   };
 
   const double total = options_.duration > 0 ? options_.duration : std::numeric_limits<double>::infinity();
-  const std::int64_t step_ns = std::llround(config.world.step * 1e9);
   Progress progress(options_.progress, std::isfinite(total) ? std::min(total, capture_length_s_ > 0 ? capture_length_s_ : total)
                                                             : capture_length_s_,
                     options_.progress_label);
   const auto t0 = std::chrono::steady_clock::now();
   const auto wall = [&] { return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(); };
   bool done = false;
+  sim::StepDriver driver(world);
+  double step_started = 0.0;
+  driver.setHooks({[&] {
+                     if (world.time() + 0.5 * config.world.step < total) return true;
+                     done = true;
+                     return false;
+                   },
+                   [&] {
+                     s.scenario_triggers += triggers.due(world);
+                     step_started = on_step ? wall() : 0.0;
+                   },
+                   [&](bool ok) {
+                     if (on_step) on_step(world, wall() - step_started);
+                     s.add(world, ok);
+                     scenarioAfterStep();
+                     publish();
+                     progress.update(world.time(), wall());
+                   }});
   try {
     // the captures merged in time order (ties: the clock's frame last), the World stepped up to each of the clock's
     Feed& clock = feeds_.front();
@@ -468,25 +429,9 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
         if (b.tracked && !(b.pose.p.allFinite() && b.pose.R.allFinite()))
           throw OfflineInputError(fmt::format("{}: frame {}: body '{}': non-finite sample", next->file, f.frame_number, b.name));
       // a capture drives the mocap sources it was given: the main one every source without its own `mocap`
-      for (const std::string& src : next->names) {
-        world.addMocap(f, src);
-        if (!world.anchored(src)) world.anchor(f.stamp_ns, src);
-      }
+      for (const std::string& src : next->names) driver.addFrame(f, src);
       if (next != &clock) continue;
-      while (world.captureTimeNs(clock_name) + step_ns <= f.stamp_ns) {
-        if (world.time() + 0.5 * config.world.step >= total) {
-          done = true;
-          break;
-        }
-        s.scenario_triggers += triggers.due(world);
-        const double before = on_step ? wall() : 0.0;
-        const bool ok = world.step();
-        if (on_step) on_step(world, wall() - before);
-        accumulate(world, ok, s);
-        scenarioAfterStep();
-        publish();
-        progress.update(world.time(), wall());
-      }
+      driver.stepTo(f.stamp_ns, clock_name);
     }
   } catch (...) {
     progress.done();

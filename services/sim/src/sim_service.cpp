@@ -10,6 +10,8 @@
 #include "mannequin/service/runtime.hpp"
 #include "mannequin/simservice/checkpoint.hpp"
 #include "mannequin/simservice/messages.hpp"
+#include "mannequin/sim/run_totals.hpp"
+#include "mannequin/sim/step_driver.hpp"
 #include "mannequin/transport/clock.hpp"
 #include "mannequin/transport/convert.hpp"
 #include "mannequin/transport/health.hpp"
@@ -30,28 +32,15 @@ struct SimService::Impl {
   std::deque<v1::MocapFrame> pending;  // replay: frames not yet stepped to
   std::vector<std::string> world_sources;  // World::mocapSources(): the sources some mannequin uses ("" first)
   std::uint64_t unused_source_frames = 0;  // frames of a listed source no mannequin uses
-  // Status line and stop summary (physics on): contacts, penetration, balance; the per-mannequin
-  // vectors are sized at construction (nothing allocated per step).
-  struct Totals {
-    int max_contacts = 0;
-    std::uint64_t failed_pairs = 0;  // collision pairs whose narrow phase failed (summed over steps)
-    double contact_sum = 0, max_penetration_m = 0;
-    std::uint64_t steps = 0;
-    std::vector<double> min_balance;  // per mannequin; NaN: no support in the period
-    void reset(int mannequins) {
-      max_contacts = 0;
-      failed_pairs = 0;
-      contact_sum = 0;
-      max_penetration_m = 0;
-      steps = 0;
-      min_balance.assign(static_cast<std::size_t>(mannequins), std::nan(""));
-    }
-  };
-  Totals period, run_totals;
+  // Status line and stop summary (physics on): contacts, penetration, balance, over the status period and
+  // the run; the per-mannequin vectors are sized at construction (nothing allocated per step).
+  sim::RunTotals period, run_totals;
   std::int64_t last_status_ns = 0;
   bool new_mocap = false;
   std::int64_t step_ns;
-  double world_phase = 0.0;  // fraction of a sim.world period accumulated (exact average rate)
+  sim::RateDivider world_rate;  // sim.world at world_rate (exact average rate)
+  sim::StepDriver driver;       // frames in, steps to their capture time (replay), one paced step (live)
+  const std::atomic<bool>* stop_flag = nullptr;  // run()'s, for the driver's hooks
   // collision lockstep
   v1::ContactSet contacts;
   bool has_contacts = false;
@@ -78,8 +67,16 @@ struct SimService::Impl {
         sub(ctx, transport::SubscriberOptions{c.name, subscriberEndpoints(c), c.mode == Mode::kReplay ? 100000 : 1000, 10000,
                                               c.curve_client}),
         health(pub, c.name, &sub, hb),
+        world_rate(c.world_rate, c.world.step),
+        driver(world),
         schedule(config.scenario.triggers),
         watch(config.scenario.state_rate, config.world.step) {
+    driver.setHooks({[this] { return stop_flag == nullptr || !stop_flag->load(); },
+                     [this] {
+                       collisionBeforeStep(*stop_flag);
+                       schedule.due(world);
+                     },
+                     [this](bool ok) { afterStep(ok); }});
     setupScenario(world, config);
     if (!config.resume.empty()) resume();
     if (!config.checkpoint.empty()) checkpoint_writer = std::make_unique<CheckpointWriter>(config.checkpoint);
@@ -192,41 +189,15 @@ struct SimService::Impl {
       pending.push_back(f);
       return;
     }
-    const mocap::Frame in = transport::fromMsg(f);
-    world.addMocap(in, *src);
+    const sim::StepDriver::Added added = driver.addFrame(transport::fromMsg(f), *src, config.reanchor_threshold);
     new_mocap = true;
-    if (!world.anchored(*src)) {
-      world.anchor(in.stamp_ns, *src);
-    } else {
-      const double drift = static_cast<double>(in.stamp_ns - world.captureTimeNs(*src)) * 1e-9 - config.world.interpolation_delay;
-      if (std::abs(drift) > config.reanchor_threshold) {
-        spdlog::info("{}: capture clock{} {} by {:.3f} s: re-anchored", config.name, src->empty() ? "" : " of " + *src,
-                     drift > 0 ? "ahead" : "behind", std::abs(drift));
-        world.anchor(in.stamp_ns, *src);
-      }
-    }
-  }
-
-  // After each step (physics on): the totals of the status period and of the run.
-  void accumulate() {
-    if (!world.physics()) return;
-    const sim::StepDiagnostics& d = world.diagnostics();
-    for (Totals* t : {&period, &run_totals}) {
-      ++t->steps;
-      t->max_contacts = std::max(t->max_contacts, d.contacts);
-      t->contact_sum += d.contacts;
-      t->max_penetration_m = std::max(t->max_penetration_m, d.max_penetration_m);
-      t->failed_pairs += static_cast<std::uint64_t>(d.failed_collision_pairs);
-      for (int m = 0; m < world.numMannequins(); ++m) {
-        const double b = world.mannequinDiagnostics(m).balance_distance_m;
-        double& mb = t->min_balance[static_cast<std::size_t>(m)];
-        if (std::isfinite(b) && !(b >= mb)) mb = b;  // NaN mb: the first finite value
-      }
-    }
+    if (added.reanchored)
+      spdlog::info("{}: capture clock{} {} by {:.3f} s: re-anchored", config.name, src->empty() ? "" : " of " + *src,
+                   added.drift_s > 0 ? "ahead" : "behind", std::abs(added.drift_s));
   }
 
   // "contacts 6 (mean 5.8, max 8), max penetration 1.23 mm, balance operator 0.043 m (min 0.012 m)".
-  std::string physicsLine(const Totals& t, bool current) const {
+  std::string physicsLine(const sim::RunTotals& t, bool current) const {
     if (!world.physics()) return "physics off";
     const sim::StepDiagnostics& d = world.diagnostics();
     std::string line = current ? fmt::format("contacts {} (mean {:.1f}, max {})", d.contacts,
@@ -234,12 +205,12 @@ struct SimService::Impl {
                                : fmt::format("contacts mean {:.1f}, max {}",
                                              t.steps > 0 ? t.contact_sum / static_cast<double>(t.steps) : 0.0, t.max_contacts);
     line += fmt::format(", max penetration {:.2f} mm", t.max_penetration_m * 1e3);
-    if (t.failed_pairs > 0) line += fmt::format(", {} collision pair tests failed (no contact)", t.failed_pairs);
+    if (t.failed_collision_pairs > 0) line += fmt::format(", {} collision pair tests failed (no contact)", t.failed_collision_pairs);
     line += ", balance";
     const auto dist = [](double v) { return std::isfinite(v) ? fmt::format("{:.3f} m", v) : std::string("none"); };
     for (int m = 0; m < world.numMannequins(); ++m) {
       line += fmt::format("{} {} ", m > 0 ? "," : "", world.name(m));
-      const double minb = t.min_balance[static_cast<std::size_t>(m)];
+      const double minb = t.min_balance_per_mannequin_m[static_cast<std::size_t>(m)];
       if (current)
         line += fmt::format("{} (min {})", dist(world.mannequinDiagnostics(m).balance_distance_m), dist(minb));
       else
@@ -301,17 +272,14 @@ struct SimService::Impl {
     if (config.mode == Mode::kReplay) waitForContacts(stop);
   }
 
-  void stepOnce(const std::atomic<bool>& stop) {
-    collisionBeforeStep(stop);
-    schedule.due(world);
-    world.step();
+  // After each step: the scenario's state, the totals, sim.world at world_rate (or at each new mocap frame).
+  void afterStep(bool ok) {
     publishScenario();
     ++stats.steps;
-    accumulate();
+    period.add(world, ok);
+    run_totals.add(world, ok);
     health.loopIteration();
-    world_phase += config.world_rate * config.world.step;
-    const bool scheduled = world_phase >= 1.0 - 1e-9;
-    if (scheduled) world_phase -= 1.0;
+    const bool scheduled = world_rate.tick();
     if (scheduled || (config.publish_on_mocap && new_mocap)) {
       toWorldState(world, has_contacts ? &contacts : nullptr, stale, config.mode == Mode::kReplay, world_msg);
       pub.publish(topics::kSimWorld, world_msg);
@@ -366,6 +334,7 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
     }
     spdlog::info("{}: mocap sources (by the publisher's name): {}", s.config.name, list);
   }
+  s.stop_flag = &stop;
   s.last_status_ns = transport::steadyNs();
   std::int64_t next = transport::steadyNs();
   service::ServiceLoop(s.health, stop, duration)
@@ -378,10 +347,9 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
                 const std::string& src = *s.sourceOf(s.pending.front());  // pending holds frames of used sources only
                 const mocap::Frame in = transport::fromMsg(s.pending.front());
                 s.pending.pop_front();
-                s.world.addMocap(in, src);
+                s.driver.addFrame(in, src);
                 s.new_mocap = true;
-                if (!s.world.anchored(src)) s.world.anchor(in.stamp_ns, src);
-                while (s.world.captureTimeNs(src) + s.step_ns <= in.stamp_ns && !stop.load()) s.stepOnce(stop);
+                s.driver.stepTo(in.stamp_ns, src);
               }
             } else {
               const std::int64_t now = transport::steadyNs();
@@ -392,7 +360,7 @@ int SimService::run(const std::atomic<bool>& stop, double duration) {
               const std::int64_t late = transport::steadyNs() - next;
               s.health.lateness(static_cast<double>(late) * 1e-9);
               s.sub.poll(microseconds(0));
-              s.stepOnce(stop);
+              s.driver.stepOnce();
               next += s.step_ns;
               if (late > 10'000'000) {  // more than 10 ms behind: resynchronise instead of running a burst of steps
                 ++s.stats.overruns;

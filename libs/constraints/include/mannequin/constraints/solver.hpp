@@ -89,6 +89,7 @@ struct SolveReport {
   int lcp_solves = 0;    ///< Lemke solves (the first and the refinement rounds')
   int warm = 0;          ///< of those, answered by the warm-start guess (0 pivots)
   long dropped = 0;      ///< rows dropped for capacity since construction
+  int refused_forces = 0; ///< systems that refused their constraint force this solve (non-finite): skipped
   bool fallback = false; ///< Lemke failed and a fallback answered (or nothing did)
   double produce_s = 0, assemble_s = 0, solve_s = 0;  ///< wall time of each stage (s)
 };

@@ -22,8 +22,9 @@ class ConstrainedSystem {
   /// b's Cholesky factor (b = Lᵀ L along the system's tree of coordinates, math::TreeCholesky) of
   /// the current step.
   virtual const math::TreeCholesky& frictionFactor() const = 0;
-  /// Adds b⁻¹Γ_c to q̇ (Γ_c: nv, generalised force of the constraints).
-  virtual void applyConstraintForce(const Eigen::VectorXd& gamma_c) = 0;
+  /// Adds b⁻¹Γ_c to q̇ (Γ_c: nv, generalised force of the constraints). Never throws in the loop: returns
+  /// false when the system refuses it (a non-finite Γ_c, no free motion this step), q̇ unchanged.
+  virtual bool applyConstraintForce(const Eigen::VectorXd& gamma_c) = 0;
 };
 
 /// A mannequin's controller as a constrained system (stage 2 of control::Controller).
@@ -33,7 +34,9 @@ class MannequinSystem final : public ConstrainedSystem {
   int nv() const override { return ctl_->model().nv; }
   const Eigen::VectorXd& qdotFree() const override { return ctl_->qdotFree(); }
   const math::TreeCholesky& frictionFactor() const override { return ctl_->apparentFrictionFactor(); }
-  void applyConstraintForce(const Eigen::VectorXd& gamma_c) override { ctl_->applyConstraintForce(gamma_c); }
+  bool applyConstraintForce(const Eigen::VectorXd& gamma_c) override {
+    return ctl_->applyConstraintForce(gamma_c) == control::ForceStatus::kOk;
+  }
   control::Controller& controller() { return *ctl_; }
   const control::Controller& controller() const { return *ctl_; }
 

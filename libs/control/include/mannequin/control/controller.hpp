@@ -48,6 +48,10 @@ namespace mannequin::control {
 
 /// Outcome of computeFreeMotion(); numerical trouble never throws in the loop.
 enum class StepStatus { kOk, kNonFinite };
+/// What setTarget did with a target: taken, or refused with the previous target kept (never throws in the loop).
+enum class TargetStatus { kOk, kNonFinite, kNotRotation };
+/// What applyConstraintForce did: added, or refused (q̇ unchanged): a non-finite torque, or stage 1 not run.
+enum class ForceStatus { kOk, kNonFinite, kNoFreeMotion };
 
 /// What a control frame's coupling did at the last step.
 struct ControlFrameState {
@@ -109,9 +113,10 @@ class Controller {
   /// \throws std::invalid_argument naming the frame and listing the control frames.
   int frameIndex(const std::string& name) const;
   const ControlFrameState& frame(int i) const { return frames_.at(i); }
-  /// \throws std::invalid_argument (frame named) on non-finite values or a non-rotation R; state kept.
-  void setTarget(int i, const SE3& oMd);
-  void setTarget(int i, const SE3& oMd, const Vector6& target_twist);
+  /// Target pose (world) and body twist of control frame i. A non-finite value or a non-rotation R is
+  /// refused (TargetStatus, the previous target kept). \throws std::invalid_argument for an index out of range.
+  TargetStatus setTarget(int i, const SE3& oMd);
+  TargetStatus setTarget(int i, const SE3& oMd, const Vector6& target_twist);
   /// Switches a coupling on/off (off: no wrench, no rows in the projectors' rank).
   void setFrameEnabled(int i, bool enabled);
   /// Scales K and B of a frame (gain tuning, 4.1.1). \throws on negative/non-finite.
@@ -152,8 +157,9 @@ class Controller {
   //---- the step ----
   StepStatus step();                       ///< computeFreeMotion() then integrate()
   StepStatus computeFreeMotion();          ///< stage 1
-  /// Stage 2: q̇ += b⁻¹ Γ_c with Γ_c = J_cᵀ W_c (nv). \throws std::invalid_argument on size/NaN.
-  void applyConstraintForce(const VectorX& gamma_c);
+  /// Stage 2: q̇ += b⁻¹ Γ_c with Γ_c = J_cᵀ W_c (nv). A non-finite Γ_c, or a call before stage 1, is refused
+  /// (ForceStatus, q̇ unchanged). \throws std::invalid_argument on a size other than nv (MANNEQUIN_CHECK_ARGUMENT_SIZE).
+  ForceStatus applyConstraintForce(const VectorX& gamma_c);
   void integrate();                        ///< stage 3
   /// b = b_a + Σ JᵀBJ at q_k (nv × nv) and its Cholesky factor b = Lᵀ L along the tree of coordinates
   /// (reuse it: b⁻¹x by factor.solveInPlace(x)).

@@ -73,7 +73,7 @@ class RigidObject final : public constraints::ConstrainedSystem, public constrai
   int nv() const override { return hinged_ ? 1 : 6; }
   const Eigen::VectorXd& qdotFree() const override { return qdot_free_; }
   const math::TreeCholesky& frictionFactor() const override { return factor_; }
-  void applyConstraintForce(const Eigen::VectorXd& gamma_c) override;
+  bool applyConstraintForce(const Eigen::VectorXd& gamma_c) override;
 
   // -- BodyFrames (one body, local 0) --
   const math::SE3& pose(int local = 0) const override;

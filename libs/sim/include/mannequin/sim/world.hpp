@@ -26,26 +26,19 @@
 /// is tracked again the weight rises back to 1 over `occlusion_blend` s (no jump).
 #include <array>
 #include <cstdint>
-#include <limits>
 #include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
-#include "mannequin/balance/static_balance.hpp"
-#include "mannequin/collision/scene.hpp"
 #include "mannequin/collision/world.hpp"
-#include "mannequin/constraints/balance.hpp"
-#include "mannequin/constraints/contacts.hpp"
-#include "mannequin/constraints/joint_limits.hpp"
-#include "mannequin/constraints/solver.hpp"
+#include "mannequin/sim/checkpoint.hpp"
+#include "mannequin/sim/config.hpp"
+#include "mannequin/sim/diagnostics.hpp"
 #include "mannequin/sim/mocap_buffer.hpp"
-#include "mannequin/control/config.hpp"
 #include "mannequin/sim/object_guides.hpp"
 #include "mannequin/sim/rigid_object.hpp"
 #include "mannequin/sim/stepper.hpp"
-#include "mannequin/sim/tracker.hpp"
-#include "mannequin/skeleton/model.hpp"
 
 namespace mannequin::scenario {
 class Engine;
@@ -53,257 +46,6 @@ struct Scenario;
 }  // namespace mannequin::scenario
 
 namespace mannequin::sim {
-
-/// A control frame driven by a mocap body.
-struct ControlFrameSpec {
-  std::string frame;  ///< model frame (e.g. "hand_l", "palm_l", "pelvis")
-  std::string body;   ///< mocap body name
-};
-
-struct MannequinSetup {
-  std::string name;             ///< instance name in sim.world
-  skeleton::Model model;        ///< built from configs/mannequins/*.yaml by the caller
-  std::vector<ControlFrameSpec> frames;
-  std::string root_frame = "pelvis";  ///< frame whose body places the mannequin at calibration
-  /// The mocap source whose bodies drive this mannequin (World::addMocap(frame, source)); "" is the
-  /// default source. Two actors captured by two systems: two mannequins with two sources, each with
-  /// its own buffer and clock anchor.
-  std::string mocap_source;
-  /// The controller's config (configs/control/*.yaml): steps the mannequin with a ControllerStepper.
-  /// Empty: the KinematicTracker with SimConfig::gains.
-  std::optional<control::ControllerConfig> controller;
-};
-
-/// The multi-contact balance controller in the loop (thesis 3.96–3.107, Algorithm 5, and 4.4.2).
-/// Every `period` s, for each calibrated mannequin: Algorithm 5 at q_k with its touching contacts with
-/// the static scene (the points, normals and μ of the step's contact rows; each body in contact held
-/// where it is), the driven frames that are neither in contact nor in `frames` as position tasks towards
-/// their mocap targets, and the margins below. Its result q_b = q_k ⊕ δq drives the mannequin through
-/// couplings, so the loop stays force-based and passive (4.4.2: "a joint controller that generates the
-/// torques giving δq"): the targets of the control frames named in `frames` (the pelvis and head of
-/// the VR-room set) become their poses at q_b instead of their mocap bodies', every other coordinate is
-/// pulled towards q_b by a joint spring-damper (the joint controller 4.4.2 proposes), and q_b is the
-/// posture target of the internal control (2.25). The spring-dampers of those couplings carry the body there
-/// against gravity; contacts, limits and the other frames act as before. A solve that fails (no
-/// equilibrium with these margins: kInfeasible) hands the frames back to their mocap bodies and the
-/// posture back to q_c until a later solve succeeds; MannequinDiagnostics says which.
-/// Allocates at each solve (like the force margins): off by default.
-struct BalanceControllerConfig {
-  bool enabled = false;
-  double period = 0.01;                     ///< s between solves (rounded to steps, ≥ 1 step)
-  std::vector<std::string> frames = {"pelvis", "head"};  ///< driven frames the controller takes over
-  /// Pushes (N, world) at the CoM the posture must hold (3.93–3.95), each balanced by non-negative
-  /// contact forces at the posture's own CoM (VariationalBalanceProblem::margins_at_com).
-  std::vector<math::Vector3> force_margins;
-  int edges = 4;                            ///< edges per linearised friction cone (3.56)
-  double max_step = 0.02;                   ///< |δq_j| per solve (rad, m): the small-displacement bound
-  double max_task_step = 0.01;              ///< m per solve a task moves its frame
-  double dq_weight = 1e6;                   ///< w_q of (3.107): 1 mrad of δq weighs as 1 N of edge force
-  /// β of the internal control (thesis 4.1): each solve pulls δq towards β (q_c ⊖ q_k), q_c the calibrated
-  /// posture, where the equilibrium, held bodies and tasks leave it free. Without it (0) nothing holds
-  /// the posture between solves: each starts from where gravity left the body, and it sinks.
-  double posture_gain = 0.2;
-  /// The joint coupling towards q_b (control::Controller::setJointCoupling) on every coordinate but the
-  /// root's (the frames in `frames` place the root): N·m/rad and N·m·s/rad.
-  double joint_stiffness = 1000.0;
-  double joint_damping = 0.0;
-};
-
-/// Physics in the loop (thesis Alg. 4): contacts between the mannequins, the scene and the objects as
-/// rows of one LCP per step with the joint limits (and balance, grasps). Needs ControllerSteppers.
-struct PhysicsConfig {
-  bool enabled = false;
-  /// Gravity (m/s², world) of every mannequin's controller when physics is on: the weight comes with
-  /// the contacts that carry it (replaces the controller config's `gravity`).
-  math::Vector3 gravity = math::Vector3(0, 0, -9.81);
-  collision::SceneSpec scene;      ///< static bodies (floor, table ...), materials, μ table
-  double segment_margin = 0.005;   ///< margin of every mannequin segment (m)
-  std::string segment_material = "skin";
-  /// Contacts between the segments of one mannequin (off by default: captured actors pass their hands
-  /// through their own trunk models and cross their feet, and those rows then fight the mocap targets).
-  bool self_collision = false;
-  int query_period_steps = 1;      ///< collision query every N steps (witness points re-evaluated at q_k in between)
-  double activation_distance = 0.02;  ///< m: pairs closer than this become rows (the predictive scheme's candidates)
-  /// The contact–control paradox (thesis 4.4.3): a foot target calibrated slightly below the floor
-  /// would push the sole into it forever. At calibration, targets of frames whose segment touches the
-  /// floor are lifted by the sole's calibration depth plus this clearance (m).
-  double calibration_clearance = 0.002;
-  constraints::ContactOptions contacts;  ///< friction edges, recovery speed (μ from the scene)
-  /// Coplanar balance (thesis 3.3.2.1): the support region of each mannequin is rebuilt every step from
-  /// its feet's floor contacts (within `foot_contact_tolerance`), and the signed distance of its CoM
-  /// projection is in MannequinDiagnostics::balance_distance_m. With `balance_rows` the distance is
-  /// also a unilateral row of the step's LCP (the CoM is kept over the support); off by default: a
-  /// captured actor's hops and steps leave the support on purpose.
-  bool balance_rows = false;
-  constraints::BalanceOptions balance;
-  double foot_contact_tolerance = 0.005;  ///< m between the margin shells: a foot touching the floor
-  /// Stability margin in disturbing forces (thesis 3.93–3.95, libs/balance): every `force_margin_period`
-  /// s (0: never), each calibrated mannequin's largest horizontal push at its CoM (±x, ±y) that its
-  /// touching contacts with the static scene hold, its CoM where it is (MannequinDiagnostics::force_margin_n,
-  /// bisection to 1 N, at most `force_margin_max` N).
-  double force_margin_period = 0.0;
-  double force_margin_max = 1000.0;
-  /// The multi-contact balance controller (libs/balance, Algorithm 5) in the loop.
-  BalanceControllerConfig balance_controller;
-  /// τ of the scene's objects without a `time_constant` (s; sim::RigidObject).
-  double object_time_constant = 0.05;
-  constraints::SolverOptions solver;
-};
-
-struct SimConfig {
-  double step = 0.001;                 ///< δt (s)
-  double interpolation_delay = 0.0;    ///< s behind the newest capture time (live mode smoothing)
-  double occlusion_hold = 0.3;         ///< s
-  double occlusion_blend = 0.5;        ///< s
-  bool calibration_needs_flag = false; ///< calibrate only on frames flagged calibration_pose
-  /// Steps of posture fitting at calibration: q_c is first pulled so that every control frame's origin
-  /// reaches its body's position (orientations free), from standing; 0 = use the standing posture as is.
-  int calibration_fit_steps = 0;
-  TrackerGains gains;                  ///< KinematicTracker gains (stepper: kinematic, calibration fit)
-  bool target_twist = true;            ///< feed the targets' velocities forward (ControllerStepper)
-  double max_target_speed = 10.0;      ///< m/s (and rad/s × 0.3 m): faster target motion is a jump
-  /// Joint limits as unilateral constraints in the ControllerStepper (nullopt: off). The kinematic
-  /// tracker always clamps to the limits.
-  std::optional<constraints::JointLimitOptions> joint_limits = constraints::JointLimitOptions{};
-  PhysicsConfig physics;
-};
-
-/// A grasp held now (World::grasp), for reports.
-struct GraspState {
-  int handle = -1;     ///< World::grasp's handle
-  int mannequin = -1;
-  int joint = -1;      ///< joint of the mannequin's model carrying the grasping frame
-  int object = -1;     ///< object index
-  math::Vector3 force = math::Vector3::Zero();  ///< N, world: on the object at the last step (the hand gets −force)
-};
-
-/// One contact after a step's solve, for sim.world and diagnostics (world frame).
-struct ContactReport {
-  int body_a = -1, body_b = -1;       ///< collision body ids (names: World::collisionWorld().bodyName)
-  math::Vector3 point = math::Vector3::Zero();   ///< m, midpoint of the witness points at q_k
-  math::Vector3 normal = math::Vector3::UnitZ(); ///< from a to b
-  double distance = 0.0;        ///< m, after margins (< 0: the margin shells overlap)
-  double normal_force = 0.0;    ///< N
-  double friction_force = 0.0;  ///< N
-};
-
-/// Per mannequin, after a step.
-struct MannequinDiagnostics {
-  int contacts = 0;                 ///< contact rows on this mannequin
-  bool foot_contact = false;        ///< a foot segment touches the floor (distance ≤ activation, λ > 0 or d ≤ 0)
-  double sole_height_m = 0.0;       ///< signed height of the lowest sole point above the floor (real geometry)
-  double balance_distance_m = std::numeric_limits<double>::quiet_NaN();  ///< signed (3.22); NaN: no support
-  double worst_joint_limit_excess_rad = 0.0;  ///< max over coordinates of how far past a limit (≥ 0)
-  math::Vector3 com = math::Vector3::Zero();  ///< centre of mass (world, m) at q_k
-  int support_points = 0;           ///< foot–floor contact points of the support region
-  /// The largest horizontal push at the CoM (N, any of ±x, ±y) the mannequin's touching contacts with
-  /// the static scene hold with its CoM where it is (balance::forceMargin, multi-contact and non-coplanar:
-  /// hands on a wall count); 0 when the posture itself has no static equilibrium (in the air, leaning
-  /// out); NaN when not evaluated (PhysicsConfig::force_margin_period 0, or not calibrated). Kept
-  /// between evaluations.
-  double force_margin_n = std::numeric_limits<double>::quiet_NaN();
-  int force_margin_contacts = 0;    ///< touching contact points the last evaluation used
-  /// The balance controller (PhysicsConfig::balance_controller): the outcome of its last solve
-  /// (kInvalid before the first), whether its result drives the mannequin now, its solves and failures.
-  balance::BalanceStatus balance_status = balance::BalanceStatus::kInvalid;
-  bool balance_driving = false;
-  int balance_contacts = 0;         ///< contact points of the last solve
-  /// Of the force margins asked for, the fraction the last solve held (1: all; the controller grows it
-  /// step by step, BalanceControllerConfig); 0 after a failure.
-  double balance_margin_fraction = 0.0;
-  /// The last solve left the tasks out: with them its equality rows were dependent (a hand task whose
-  /// forearm is held on a wall).
-  bool balance_tasks_dropped = false;
-  math::Vector3 balance_com = math::Vector3::Zero();  ///< the controller's CoM (world, m): at q_b, linearised
-  long balance_solves = 0, balance_failures = 0;  ///< solves (every margin fraction tried), failed updates
-};
-
-/// What the last step did (thesis Alg. 4 stages), for callers and sim.world.
-struct StepDiagnostics {
-  int contacts = 0;                  ///< contact rows
-  int active_contacts = 0;           ///< with λ > 0
-  double max_penetration_m = 0.0;    ///< deepest penetration of the real geometry (margins excluded), ≥ 0
-  int failed_collision_pairs = 0;    ///< pairs of this step's collision query (if any) whose narrow phase failed (no contact)
-  constraints::SolveReport solver;   ///< rows, LCP size, solver used, pivots, fallback
-  bool nan = false;                  ///< a mannequin step produced non-finite numbers (state kept)
-  double collision_s = 0, free_motion_s = 0, constraints_s = 0, integrate_s = 0;  ///< wall time per stage
-};
-
-/// Mocap glitches the World met, counted per kind over its life (all sources); sim.world carries them
-/// (`mocap_glitches`), docs/cluster.md "Faults".
-struct MocapGlitches {
-  std::uint64_t duplicate_frames = 0;     ///< a frame with its source's newest capture time: ignored
-  std::uint64_t out_of_order_frames = 0;  ///< a frame older than the newest, by at most the buffer window: ignored
-  /// A frame older than the newest by more than the buffer window (2 s): a restarted capture clock (a
-  /// restarted mocap service); the source's buffer starts again from it and, anchored, is re-anchored.
-  std::uint64_t capture_restarts = 0;
-  std::uint64_t non_finite_bodies = 0;    ///< tracked bodies with a NaN/inf pose: taken as untracked
-  /// Tracked bodies farther from their last tracked position than `max_target_speed` m/s × the time
-  /// since (+ 5 cm): a marker swap, taken as untracked (held) until the elapsed time allows the distance.
-  /// Not when every tracked body of the frame jumps (the actor relocated, a looping capture's wrap): taken as is.
-  std::uint64_t pose_jumps = 0;
-  std::uint64_t occlusions = 0;           ///< a driven body went from tracked to untracked
-  /// Steps where a driven frame's target position moved faster than `max_target_speed` m/s (a 2 m marker
-  /// swap, a re-tracked body, a re-anchored clock; fast real motion of a hand body's offset too): its
-  /// twist is not fed forward.
-  std::uint64_t target_jumps = 0;
-  /// A source's newest frame got older than `occlusion_hold` at its capture time (the stream stopped: a
-  /// mocap service died, a network gap). Its bodies keep their last targets at full weight (the whole
-  /// actor held: blending every frame out let the mannequin sag). When frames come back, each target keeps
-  /// the offset it then has to its body, shrinking at 1 m/s (and 3.3 rad/s): it catches up without a jump.
-  std::uint64_t stream_gaps = 0;
-};
-
-/// A control frame driven by a mocap body, after a step: the World's calibration (bMf), the target it
-/// derives from the body, and how well the mannequin follows it. The controller's coupling on the same
-/// frame (gains, wrench, port energy) is control::ControlFrameState. The wire's v1::ControlFrameState is
-/// filled from this.
-struct DrivenFrame {
-  std::string frame, body;
-  int frame_index = -1;
-  math::SE3 offset;         ///< bMf from calibration
-  math::SE3 target;         ///< world
-  math::SE3 actual;         ///< world
-  bool tracked = false;
-  double weight = 0.0;
-  double position_error = 0.0;     ///< m
-  double orientation_error = 0.0;  ///< rad
-  /// Its command mode (scenario::toString of scenario::ControlMode): "free" unless a scenario commands it.
-  const char* mode = "free";
-};
-
-/// A World's state as a restarted sim puts it back (World::checkpoint, World::restore; the sim service
-/// keeps one in its checkpoint file, simservice/checkpoint.hpp). Velocities are not part of it: what is
-/// restored starts at rest.
-struct MannequinCheckpoint {
-  std::string name;                 ///< instance name
-  std::string model;                ///< skeleton::Model::name (a restore into another model is refused)
-  skeleton::VectorX q;              ///< configuration (nq): root (p, rotation vector) then joints
-  bool calibrated = false;
-  skeleton::VectorX q_posture;      ///< q_c, the posture target set at calibration (nq; calibrated only)
-  /// A driven control frame's calibration (calibrated only; every driven frame, any order).
-  struct Frame {
-    std::string frame, body;
-    math::SE3 offset;               ///< bMf
-    math::SE3 target;               ///< world: the last target (held until the mocap drives it again)
-    double weight = 1.0;            ///< in [0, 1]
-  };
-  std::vector<Frame> frames;
-};
-
-/// A movable object's pose (PhysicsConfig scene objects).
-struct ObjectCheckpoint {
-  std::string name;
-  bool hinged = false;
-  math::SE3 pose;                   ///< world (free body)
-  double angle = 0.0;               ///< rad (hinged)
-};
-
-struct WorldCheckpoint {
-  std::uint64_t step = 0;           ///< step count (the World's time = step · δt)
-  std::vector<MannequinCheckpoint> mannequins;  ///< every mannequin of the World, any order
-  std::vector<ObjectCheckpoint> objects;        ///< every object of the World, any order
-};
 
 class World {
  public:
@@ -438,32 +180,59 @@ class World {
   const GuideRows* guides() const;
 
  private:
+  // The private state (src/world_state.hpp) and the stages of step(), each in the source file named.
   struct Mannequin;
   struct Physics;
   struct Source;
+  struct ScenarioRun;
+  //---- mocap input (mocap_input.cpp) ----
   Source* findSource(const std::string& name);
   const Source* findSource(const std::string& name) const;
+  /// Stage: counts the sources whose newest frame got older than occlusion_hold (MocapGlitches::stream_gaps).
+  void detectStreamGaps();
+  //---- calibration (calibration.cpp) ----
   void calibrate(Mannequin& m, const mocap::Frame& frame);
-  void updateForceMargins();
-  void updateBalanceController();
-  void applyBalanceTargets(std::size_t m);
-  void updateSupport();
-  void fillDiagnostics();
-  void buildPhysics();
   /// Distance after margins of mannequin m's lowest sole to the floor at q (m; +inf: no floor).
   double soleGap(Mannequin& m, const skeleton::VectorX& q);
+  //---- targets (drive_targets.cpp) ----
+  /// Stage: the targets of m's control frames from their mocap bodies at the capture time of this step.
   void driveTargets(Mannequin& m, double dt);
-  bool physicsStep();
   math::Vector6 targetTwist(Mannequin& m, std::size_t i, double dt) const;
+  //---- the scenario (scenario_binding.cpp) ----
+  /// Stage: the scenario engine's step; its setpoints replace the commanded frames' targets.
+  void stepScenario();
+  //---- physics (physics_scene.cpp, physics_step.cpp) ----
+  void buildPhysics();
+  /// The physics stages: computeFreeMotion, updateContacts, updateSupport, the LCP, integrate, then
+  /// computeDiagnostics and the periodic balance stages. Returns false if a mannequin's step failed.
+  bool physicsStep();
+  /// Stage 1 (thesis Alg. 4): every mannequin's and object's free motion at q_k.
+  bool computeFreeMotion();
+  /// Contacts at q_k: a collision query every query_period_steps (grasped pairs removed) into the contact rows.
+  void updateContacts();
+  /// Stage 3: integration of the solved velocities, kinematics at q_{k+1}.
+  bool integrate();
+  /// Without physics: each mannequin's stepper alone.
+  bool kinematicStep();
+  //---- diagnostics (diagnostics.cpp) ----
+  /// The step's contacts as reports and each mannequin's diagnostics (contacts as solved at q_k).
+  void computeDiagnostics();
+  /// Each driven frame's pose at q_{k+1} and its errors to its target.
+  void updateFrameErrors();
+  //---- balance (balance_loop.cpp) ----
+  void updateSupport();
+  void updateForceMargins();
+  void updateBalanceController();
+  /// Stage: the frames the balance controller took over get their poses at q_b as targets.
+  void applyBalanceTargets(std::size_t m);
+
   std::vector<std::unique_ptr<Mannequin>> mannequins_;
   SimConfig config_;
   std::vector<std::unique_ptr<Source>> sources_;  // "" first
   std::uint64_t steps_ = 0, failed_steps_ = 0;
   MocapGlitches glitches_;
   std::vector<std::size_t> jumps_;  // addMocap: the bodies of a frame that jumped (kept: no allocation per frame)
-  struct ScenarioRun;
   std::unique_ptr<ScenarioRun> scenario_;
-  void stepScenario();
   std::unique_ptr<Physics> physics_;
   StepDiagnostics diagnostics_;
   std::vector<MannequinDiagnostics> mannequin_diagnostics_;

@@ -31,6 +31,11 @@
 
 namespace mannequin::transport {
 
+/// Stamps a message's Header as everything the project sends or records does (the Publisher live, the
+/// offline run's MCAP writer): schema_version = kSchemaVersion, `sequence`, `source`, `send_time_ns`
+/// (0 for deterministic output). Keeps stamp_ns (the caller's capture or simulation time).
+void stampHeader(v1::Header& header, std::uint64_t sequence, const std::string& source, std::int64_t send_time_ns);
+
 struct PublisherOptions {
   std::string source;                   ///< Header.source of everything published (service name)
   std::vector<std::string> endpoints;   ///< where to bind (at least one)

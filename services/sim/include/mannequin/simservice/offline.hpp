@@ -17,6 +17,7 @@
 
 #include "mannequin/ergonomics/ergonomics.hpp"
 #include "mannequin/mocap/source.hpp"
+#include "mannequin/sim/run_totals.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/simservice/config.hpp"
 
@@ -47,27 +48,13 @@ struct ErgonomicsSummary {
   long long failures = 0;  ///< postures the evaluator refused (non-finite q)
 };
 
-/// What a run measured (mannequin-simulate's --json keys).
-struct OfflineSummary {
-  static constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
-  long long frames = 0, steps = 0, nan_steps = 0, lcp_failures = 0, worlds = 0;
+/// What a run measured (mannequin-simulate's --json keys): the steps' totals (sim::RunTotals) and the run's.
+struct OfflineSummary : sim::RunTotals {
+  long long frames = 0, lcp_failures = 0, worlds = 0;
   double sim_time_s = 0, wall_s = 0;
-  double max_penetration_m = 0;
-  int max_contacts = 0;
-  double contact_sum = 0;
-  long long foot_contact_steps = 0;
-  double min_balance_distance_m = kNaN;  // NaN: never a support polygon
-  double min_force_margin_n = kNaN;      // NaN: never evaluated (physics.force_margin_period 0)
-  double force_margin_sum = 0;
-  long long force_margin_samples = 0;
-  double worst_joint_limit_excess_rad = 0;
-  // the balance controller (physics.balance_controller): solves and failed updates (all mannequins, at the
-  // end), mannequin-steps it drove, and of those the ones with the whole margin asked for held
+  // the balance controller (physics.balance_controller): solves and failed updates (all mannequins, at the end)
   bool balance_controller = false;
   long long balance_solves = 0, balance_failures = 0;
-  long long balance_driving_steps = 0, balance_full_margin_steps = 0, mannequin_steps = 0;
-  double hand_error_sum = 0, foot_error_sum = 0;
-  long long hand_samples = 0, foot_samples = 0;
   bool physics = false;
   std::vector<ErgonomicsSummary> ergonomics;
   /// The scenario (sim config `scenario`, --scenario): "" without one; the states entered with their sim
@@ -82,22 +69,7 @@ struct OfflineSummary {
   std::vector<ScenarioEntry> scenario_timeline;
   long long scenario_triggers = 0, scenario_unapplied_actions = 0, scenario_states = 0;
 
-  double meanContacts() const { return steps > 0 ? contact_sum / static_cast<double>(steps) : 0.0; }
-  double footContactFraction() const {
-    return steps > 0 ? static_cast<double>(foot_contact_steps) / static_cast<double>(steps) : 0.0;
-  }
-  double meanHandError() const { return hand_samples > 0 ? hand_error_sum / static_cast<double>(hand_samples) : kNaN; }
-  double meanFootError() const { return foot_samples > 0 ? foot_error_sum / static_cast<double>(foot_samples) : kNaN; }
   double realtimeFactor() const { return wall_s > 0 ? sim_time_s / wall_s : kNaN; }
-  double balanceDrivingFraction() const {
-    return mannequin_steps > 0 ? static_cast<double>(balance_driving_steps) / static_cast<double>(mannequin_steps) : kNaN;
-  }
-  double balanceFullMarginFraction() const {
-    return balance_driving_steps > 0 ? static_cast<double>(balance_full_margin_steps) / static_cast<double>(balance_driving_steps) : kNaN;
-  }
-  double meanForceMargin() const {
-    return force_margin_samples > 0 ? force_margin_sum / static_cast<double>(force_margin_samples) : kNaN;
-  }
 };
 
 /// A bad input file (config, mannequin, scene, capture, a non-finite sample): the message names the

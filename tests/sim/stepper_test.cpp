@@ -17,6 +17,7 @@
 #include "mannequin/sim/controller_stepper.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
+#include "../common/mannequins.hpp"
 
 using namespace mannequin;
 using namespace mannequin::sim;
@@ -28,10 +29,7 @@ v1::MocapFrame toWire(const mocap::Frame& f, const std::string& kind) {
   return m;
 }
 
-const skeleton::Model& male50() {
-  static const skeleton::Model m = skeleton::buildMannequin(skeleton::loadMannequinSpec("configs/mannequins/male_50th.yaml"));
-  return m;
-}
+using mannequin::testing::male50;
 
 math::Vector6 gains(double rot, double lin) {
   math::Vector6 g;

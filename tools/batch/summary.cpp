@@ -1,0 +1,134 @@
+// mannequin-batch: summary.json, one object per run (run.hpp).
+#include <fmt/format.h>
+
+#include "mannequin/core/text.hpp"
+#include "run.hpp"
+
+namespace mannequin::batch {
+
+namespace {
+
+std::string vec3Json(const ergonomics::Vector3& v) { return fmt::format("[{}, {}, {}]", num(v.x()), num(v.y()), num(v.z())); }
+
+std::string series(const std::vector<double>& v) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < v.size(); ++i) out += (i ? ", " : "") + num(v[i]);
+  return out + "]";
+}
+
+std::string scoreJson(const std::vector<Worst>& all, const long long* hist, int max_score, double max, double mean_score) {
+  std::string h = "{";
+  for (int k = 1; k <= max_score; ++k) h += fmt::format("{}\"{}\": {}", k > 1 ? ", " : "", k, hist[k]);
+  h += "}";
+  std::string w = "[";
+  const std::vector<Worst> top = worst(all);
+  for (std::size_t i = 0; i < top.size(); ++i)
+    w += fmt::format("{}{{\"time_s\": {}, \"score\": {}}}", i ? ", " : "", num(top[i].time_s), top[i].score);
+  w += "]";
+  return fmt::format("{{\"max\": {}, \"mean\": {}, \"histogram\": {}, \"worst_frames\": {}}}", num(max), num(mean_score), h, w);
+}
+
+}  // namespace
+
+std::string runJson(const Run& r) {
+  const simservice::OfflineSummary& s = r.summary;
+  std::string frames = "{";
+  for (std::size_t i = 0; i < r.frame_names.size(); ++i)
+    frames += fmt::format("{}{}: {{\"mean_m\": {}, \"max_m\": {}, \"samples\": {}}}", i ? ", " : "", core::jsonString(r.frame_names[i]),
+                          num(r.frame_n[i] ? r.frame_sum[i] / static_cast<double>(r.frame_n[i]) : kNaN), num(r.frame_n[i] ? r.frame_max[i] : kNaN),
+                          r.frame_n[i]);
+  frames += "}";
+  const simservice::ErgonomicsSummary& e = s.ergonomics.front();
+  std::string shots = "[";
+  for (std::size_t i = 0; i < r.snapshots.size(); ++i) {
+    const batch::Snapshot& p = r.snapshots[i];
+    shots += fmt::format("{}{{\"time_s\": {}, \"rula\": {}, \"reba\": {}, \"file\": {}}}", i ? ", " : "", num(p.sample.time_s),
+                         p.sample.rula, p.sample.reba, core::jsonString(p.file));
+  }
+  shots += "]";
+  std::string reach = "[";
+  for (std::size_t i = 0; i < r.reach.size(); ++i) {
+    const batch::ReachOutcome& o = r.reach[i];
+    reach += fmt::format(
+        "{}{{\"name\": {}, \"hand\": \"{}\", \"point\": {}, \"reached\": {}, \"miss_m\": {}, \"best_margin_m\": {}, "
+        "\"best_time_s\": {}, \"best_distance_m\": {}, \"shoulder_at_best\": {}, \"arm_length_m\": {}, \"samples\": {}, "
+        "\"reached_samples\": {}}}",
+        i ? ", " : "", core::jsonString(o.target.name), ergonomics::toString(o.target.side), vec3Json(o.target.point),
+        o.reached() ? "true" : "false", num(o.samples ? o.missM() : kNaN), num(o.best_margin_m), num(o.best_time_s),
+        num(o.best_distance_m), vec3Json(o.best_shoulder), num(o.arm_length_m), o.samples, o.reached_samples);
+  }
+  reach += "]";
+  std::string levels_rula, levels_reba, above_rula, above_reba;
+  for (std::size_t i = 0; i < e.rula_time_s.size(); ++i) levels_rula += (i ? ", " : "") + num(e.rula_time_s[i]);
+  for (std::size_t i = 0; i < e.reba_time_s.size(); ++i) levels_reba += (i ? ", " : "") + num(e.reba_time_s[i]);
+  for (std::size_t i = 0; i < e.rula_time_s.size(); ++i) above_rula += (i ? ", " : "") + num(timeAtOrAbove(e.rula_time_s, i));
+  for (std::size_t i = 0; i < e.reba_time_s.size(); ++i) above_reba += (i ? ", " : "") + num(timeAtOrAbove(e.reba_time_s, i));
+  const auto hand = [&](int side) {
+    return fmt::format("{{\"mean\": {}, \"max\": {}, \"max_load_kg\": {}}}", num(e.meanHandForce(side)),
+                       num(e.hand_force_samples ? e.hand_force_max_n[static_cast<std::size_t>(side)] : kNaN),
+                       num(e.hand_force_samples ? e.hand_load_max_kg[static_cast<std::size_t>(side)] : kNaN));
+  };
+  return fmt::format(
+      "{{\"mannequin_config\": {}, \"label\": {}, \"mannequin\": {}, \"mcap\": {}, \"frames\": {}, \"steps\": {}, \"sim_time_s\": {}, "
+      "\"samples\": {}, \"nan_steps\": {}, \"lcp_failures\": {}, "
+      "\"tracking_error\": {{\"per_control_frame\": {}, \"mean_m\": {}, \"max_m\": {}}}, "
+      "\"max_penetration_m\": {}, \"min_balance_distance_m\": {}, \"max_contacts\": {}, \"mean_contacts\": {}, "
+      "\"foot_contact_fraction\": {}, "
+      "\"contact_force_n\": {{\"mean\": {}, \"max\": {}, \"p95\": {}}}, "
+      "\"rula\": {}, \"rula_time_at_action_level_s\": [{}], \"reba\": {}, \"reba_time_at_action_level_s\": [{}], "
+      "\"rula_time_at_or_above_action_level_s\": [{}], \"reba_time_at_or_above_action_level_s\": [{}], "
+      "\"hand_force_n\": {{\"left\": {}, \"right\": {}}}, \"min_force_margin_n\": {}, "
+      "\"series\": {{\"time_s\": {}, \"rula\": {}, \"reba\": {}, \"balance_distance_m\": {}, \"contacts\": {}, \"contact_force_n\": {}, "
+      "\"penetration_m\": {}, \"tracking_error_m\": {}, \"hand_force_l_n\": {}, \"hand_force_r_n\": {}}}, \"snapshots\": {}, \"reach\": {}, "
+      "\"wall_s\": {}, \"realtime_factor\": {}, \"time_per_step_us\": {{\"mean\": {}, \"max\": {}}}}}",
+      core::jsonString(r.config), core::jsonString(r.label), core::jsonString(e.mannequin), core::jsonString(r.mcap), s.frames, s.steps,
+      num(s.sim_time_s), e.samples, s.nan_steps, s.lcp_failures, frames, num(mean(r.tracking)), num(maxOf(r.tracking)),
+      num(s.max_penetration_m), num(s.min_balance_distance_m), s.max_contacts, num(s.meanContacts()), num(s.footContactFraction()),
+      num(mean(r.force)), num(maxOf(r.force)), num(percentile(r.force, 0.95)),
+      scoreJson(r.rula_all, r.rula_hist.data(), 7, maxOf(r.rula), mean(r.rula)), levels_rula,
+      scoreJson(r.reba_all, r.reba_hist.data(), 15, maxOf(r.reba), mean(r.reba)), levels_reba, above_rula, above_reba, hand(0), hand(1),
+      num(s.min_force_margin_n), series(r.t), series(r.rula),
+      series(r.reba), series(r.balance), series(r.contacts), series(r.force), series(r.penetration), series(r.tracking), series(r.hand_l), series(r.hand_r), shots, reach,
+      num(s.wall_s), num(s.realtimeFactor()), num(r.step_n ? 1e6 * r.step_wall_sum / static_cast<double>(r.step_n) : kNaN),
+      num(1e6 * r.step_wall_max));
+}
+
+/// An inline SVG line plot of y(t) (NaN breaks the line), fixed y range if lo < hi given.
+std::string plot(const std::string& title, const std::vector<double>& t, const std::vector<double>& y, double lo, double hi,
+                 const char* colour) {
+  const double W = 420, H = 160, L = 44, R = 8, T = 20, B = 24;
+  if (!(lo < hi)) {
+    lo = minOf(y), hi = maxOf(y);
+    if (!std::isfinite(lo)) lo = 0, hi = 1;
+    if (hi - lo < 1e-9) lo -= 0.5, hi += 0.5;
+  }
+  const double t0 = t.empty() ? 0 : t.front(), t1 = t.empty() || t.back() <= t0 ? t0 + 1 : t.back();
+  const auto X = [&](double v) { return L + (v - t0) / (t1 - t0) * (W - L - R); };
+  const auto Y = [&](double v) { return T + (hi - std::clamp(v, lo, hi)) / (hi - lo) * (H - T - B); };
+  std::string svg = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\" role=\"img\">"
+      "<title>{2}</title><text x=\"{3}\" y=\"14\" font-size=\"12\">{2}</text>"
+      "<rect x=\"{3}\" y=\"{4}\" width=\"{5}\" height=\"{6}\" fill=\"none\" stroke=\"#999\"/>"
+      "<text x=\"{7}\" y=\"{8}\" font-size=\"10\" text-anchor=\"end\">{9}</text>"
+      "<text x=\"{7}\" y=\"{10}\" font-size=\"10\" text-anchor=\"end\">{11}</text>"
+      "<text x=\"{3}\" y=\"{12}\" font-size=\"10\">{13} s</text>"
+      "<text x=\"{14}\" y=\"{12}\" font-size=\"10\" text-anchor=\"end\">{15} s</text>",
+      W, H, html(title), L, T, W - L - R, H - T - B, L - 3, T + 8, shortNum(hi, 2), H - B, shortNum(lo, 2), H - 8, shortNum(t0, 1),
+      W - R, shortNum(t1, 1));
+  std::string pts;
+  const auto flush = [&] {
+    if (!pts.empty()) svg += fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.2\" points=\"{}\"/>", colour, pts);
+    pts.clear();
+  };
+  for (std::size_t i = 0; i < t.size() && i < y.size(); ++i) {
+    if (!std::isfinite(y[i])) {
+      flush();
+      continue;
+    }
+    pts += fmt::format("{}{:.1f},{:.1f}", pts.empty() ? "" : " ", X(t[i]), Y(y[i]));
+  }
+  flush();
+  return svg + "</svg>";
+}
+
+}  // namespace mannequin::batch
