@@ -3,6 +3,11 @@
 # Compile options every project target gets (warnings, sanitizers).
 add_library(mannequin_options INTERFACE)
 target_compile_options(mannequin_options INTERFACE -Wall -Wextra -Wpedantic)
+# In a unity batch every source is an included file, so GCC takes a class of a source's anonymous
+# namespace used by another of its classes for a header's (-Wsubobject-linkage); it is not one.
+if(CMAKE_UNITY_BUILD AND CMAKE_CXX_COMPILER_ID STREQUAL "GNU")
+  target_compile_options(mannequin_options INTERFACE -Wno-subobject-linkage)
+endif()
 if(MANNEQUIN_WERROR)
   target_compile_options(mannequin_options INTERFACE -Werror)
 endif()

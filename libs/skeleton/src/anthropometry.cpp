@@ -9,7 +9,7 @@
 namespace mannequin::skeleton {
 
 namespace {
-constexpr double kDeg = 3.14159265358979323846 / 180.0;
+constexpr double kRadPerDeg = 3.14159265358979323846 / 180.0;
 constexpr double kPi = 3.14159265358979323846;
 
 // ---- de Leva (1996) Table 4 -------------------------------------------------------------
@@ -122,8 +122,8 @@ struct Builder {
     const int i = model.joints[joint].idx_q;
     // mirroring a rotation vector negates its x and z components
     const auto set = [&](int k, const double* r, bool flip) {
-      if (flip) model.setLimits(i + k, -r[1] * kDeg, -r[0] * kDeg);
-      else model.setLimits(i + k, r[0] * kDeg, r[1] * kDeg);
+      if (flip) model.setLimits(i + k, -r[1] * kRadPerDeg, -r[0] * kRadPerDeg);
+      else model.setLimits(i + k, r[0] * kRadPerDeg, r[1] * kRadPerDeg);
     };
     set(0, l.x, right);
     set(1, l.y, false);
@@ -133,7 +133,7 @@ struct Builder {
   int revolute(const std::string& name, int parent, const Vector3& offset, const Vector3& axis_left, bool right,
                double lo_deg, double hi_deg) {
     const int j = model.addJoint(name, JointType::kRevolute, parent, at(offset), right ? mirrorAxis(axis_left) : axis_left);
-    model.setLimits(model.joints[j].idx_q, lo_deg * kDeg, hi_deg * kDeg);
+    model.setLimits(model.joints[j].idx_q, lo_deg * kRadPerDeg, hi_deg * kRadPerDeg);
     return j;
   }
 };
@@ -246,7 +246,7 @@ Model buildMannequin(const MannequinSpec& spec) {
     if (it == names.end())
       throw std::invalid_argument("mannequin '" + spec.name + "': joint limit override for unknown coordinate '" +
                                   coord + "'");
-    model.setLimits(static_cast<int>(it - names.begin()), lim.first * kDeg, lim.second * kDeg);
+    model.setLimits(static_cast<int>(it - names.begin()), lim.first * kRadPerDeg, lim.second * kRadPerDeg);
   }
   // swing/twist limits of every ball joint: from the boxes above, overridden by the spec
   for (const auto& [jname, deg] : spec.ball_limits_deg) {
@@ -322,16 +322,16 @@ BallLimit ballLimitFromSpec(const Model& model, int joint, const MannequinSpec::
     swingBasis(l.twist_axis, l.swing_x, l.swing_y);
   }
   if (deg.swing_axes) {
-    l.swing_a = deg.swing_axes->first * kDeg;
-    l.swing_b = deg.swing_axes->second * kDeg;
+    l.swing_a = deg.swing_axes->first * kRadPerDeg;
+    l.swing_b = deg.swing_axes->second * kRadPerDeg;
   }
   if (deg.swing_center) {
-    l.swing_cx = deg.swing_center->first * kDeg;
-    l.swing_cy = deg.swing_center->second * kDeg;
+    l.swing_cx = deg.swing_center->first * kRadPerDeg;
+    l.swing_cy = deg.swing_center->second * kRadPerDeg;
   }
   if (deg.twist) {
-    l.twist_lower = deg.twist->first * kDeg;
-    l.twist_upper = deg.twist->second * kDeg;
+    l.twist_lower = deg.twist->first * kRadPerDeg;
+    l.twist_upper = deg.twist->second * kRadPerDeg;
   }
   return l;
 }

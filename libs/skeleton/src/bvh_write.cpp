@@ -23,7 +23,7 @@ Matrix3 mannequinToBvhAxes() {
 namespace {
 
 constexpr double kCm = 100.0;
-constexpr double kDeg = 180.0 / std::numbers::pi;
+constexpr double kDegPerRad = 180.0 / std::numbers::pi;
 
 // R = Rz(a) Rx(b) Ry(c) → (a, b, c) in degrees
 Vector3 eulerZXY(const Matrix3& R) {
@@ -37,7 +37,7 @@ Vector3 eulerZXY(const Matrix3& R) {
     c = 0.0;
     a = std::atan2(R(1, 0), R(0, 0));
   }
-  return Vector3(a, b, c) * kDeg;
+  return Vector3(a, b, c) * kDegPerRad;
 }
 
 void indent(std::ostream& out, int depth) {
