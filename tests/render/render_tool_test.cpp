@@ -19,7 +19,7 @@
 #include <filesystem>
 #include <fstream>
 
-#include "../../services/render/swap_barrier.hpp"
+#include "mannequin/renderservice/swap_barrier.hpp"
 #include "../common/tool_run.hpp"
 #include "fixtures.hpp"
 #include "mannequin/proto/schema.hpp"
@@ -325,7 +325,7 @@ TEST_F(RenderTool, TheLauncherRunsARenderNodeLikeAnyService) {
   for (const fs::path& d : {run_dir, out}) fs::remove_all(d);
 }
 
-// The swap barrier alone (services/render/swap_barrier.cpp): node wall_b between the leader wall_a and
+// The swap barrier alone (services/render/src/swap_barrier.cpp): node wall_b between the leader wall_a and
 // wall_c, its peers' posts handed to it by a scripted poll (one per call), timeout 0.2 s on a scripted
 // clock: a poll without traffic advances it by the poll's wait, so no real time passes.
 class SwapBarrierScript {
@@ -347,15 +347,15 @@ class SwapBarrierScript {
   }
   void deliver(const std::string& node, std::uint64_t frame) { barrier_.onMessage(post(node, frame)); }
   void script(const std::string& node, std::uint64_t frame) { script_.push_back(post(node, frame)); }
-  render_node::SwapBarrier& barrier() { return barrier_; }
+  renderservice::SwapBarrier& barrier() { return barrier_; }
 
  private:
   zmq::context_t context_;
   transport::Publisher pub_;
   std::vector<v1::RenderSync> script_;
   std::size_t next_ = 0;
-  render_node::SwapBarrier::Clock::time_point now_{};  // the scripted clock
-  render_node::SwapBarrier barrier_;
+  renderservice::SwapBarrier::Clock::time_point now_{};  // the scripted clock
+  renderservice::SwapBarrier barrier_;
 };
 
 TEST(SwapBarrier, AFollowerDrawsTheStepAPeerRelaysWhenTheLeaderDiedSendingIt) {

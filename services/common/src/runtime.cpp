@@ -7,8 +7,9 @@
 
 namespace mannequin::service {
 
-void addCommonOptions(CLI::App& app, CommonOptions& o) {
-  app.add_option("--config", o.config, "service config (YAML)")->required()->check(CLI::ExistingFile);
+void addCommonOptions(CLI::App& app, CommonOptions& o, ConfigFile config) {
+  if (config == ConfigFile::kRequired)
+    app.add_option("--config", o.config, "service config (YAML)")->required()->check(CLI::ExistingFile);
   app.add_option("--name", o.name, "instance name (message source, heartbeat name)");
   app.add_option("--publish", o.publish, "endpoint to bind (tcp://HOST:PORT, ipc://PATH); repeatable, overrides the config");
   app.add_option("--connect", o.connect, "publisher endpoint to connect to; repeatable, overrides the config");
@@ -30,7 +31,9 @@ void addCommonOptions(CLI::App& app, CommonOptions& o) {
       ->check(CLI::Range(1, 16));
 }
 
-Cli::Cli(std::string description) : app(std::move(description)) { addCommonOptions(app, options); }
+Cli::Cli(std::string description, ConfigFile config) : app(std::move(description)) {
+  addCommonOptions(app, options, config);
+}
 
 int Cli::run(int argc, char** argv, const std::function<int(const std::atomic<bool>& stop)>& body) {
   return core::runMain(app, argc, argv, [&] {
@@ -40,6 +43,11 @@ int Cli::run(int argc, char** argv, const std::function<int(const std::atomic<bo
 }
 
 core::ConfigNode loadConfig(const CommonOptions& o, const std::function<void(YAML::Node&)>& overrides) {
+  if (o.config.empty()) {  // ConfigFile::kNone: the command line only
+    YAML::Node empty(YAML::NodeType::Map);
+    if (overrides) overrides(empty);
+    return core::ConfigNode(empty, "(command line)");
+  }
   core::ConfigNode loaded = core::ConfigNode::load(o.config);  // syntax errors with their line
   if (!overrides) return loaded;
   YAML::Node raw = YAML::Clone(YAML::LoadFile(o.config));
@@ -47,12 +55,13 @@ core::ConfigNode loadConfig(const CommonOptions& o, const std::function<void(YAM
   return core::ConfigNode(raw, o.config);
 }
 
-Endpoints resolveEndpoints(const CommonOptions& o, const core::ConfigNode& config, const std::string& default_name) {
+Endpoints resolveEndpoints(const CommonOptions& o, const core::ConfigNode& config, const std::string& default_name,
+                           Publish publish) {
   Endpoints e;
   e.name = o.name.empty() ? config.get("name", default_name) : o.name;
   e.publish = o.publish;
   if (e.publish.empty() && config.has("publish")) e.publish = config["publish"].strings();
-  if (e.publish.empty()) throw core::ConfigError(o.config + ": no publish endpoint (config 'publish' or --publish)");
+  if (e.publish.empty() && publish == Publish::kRequired) throw core::ConfigError(o.config + ": no publish endpoint (config 'publish' or --publish)");
   e.connect = o.connect;
   if (e.connect.empty() && config.has("connect")) e.connect = config["connect"].strings();
   if (o.security.empty()) {
@@ -152,7 +161,10 @@ transport::SubscriberOptions subscriberOptions(const Endpoints& e) {
 }
 
 ServiceLoop::ServiceLoop(transport::HealthReporter& health, const std::atomic<bool>& stop, double duration_s)
-    : health_(health), stop_(stop), duration_s_(duration_s) {}
+    : ServiceLoop(&health, stop, duration_s) {}
+
+ServiceLoop::ServiceLoop(transport::HealthReporter* health, const std::atomic<bool>& stop, double duration_s)
+    : health_(health), stop_(stop), duration_s_(duration_s), start_ns_(core::steadyNs()) {}
 
 bool ServiceLoop::stopping() const { return stop_.load() || (duration_s_ > 0 && elapsed() >= duration_s_); }
 
@@ -161,15 +173,19 @@ double ServiceLoop::elapsed() const { return static_cast<double>(core::steadyNs(
 int ServiceLoop::run(const std::function<bool()>& iteration, const std::function<void()>& on_heartbeat,
                      const std::function<void()>& on_stop) {
   start_ns_ = core::steadyNs();
-  health_.setState(v1::SERVICE_STATE_RUNNING);
-  health_.tick(true);
+  if (health_ != nullptr) {
+    health_->setState(v1::SERVICE_STATE_RUNNING);
+    health_->tick(true);
+  }
   while (!stopping()) {
     if (!iteration()) break;
-    if (health_.tick() && on_heartbeat) on_heartbeat();
+    if (health_ != nullptr && health_->tick() && on_heartbeat) on_heartbeat();
   }
   if (on_stop) on_stop();
-  health_.setState(v1::SERVICE_STATE_STOPPING);
-  health_.tick(true);
+  if (health_ != nullptr) {
+    health_->setState(v1::SERVICE_STATE_STOPPING);
+    health_->tick(true);
+  }
   return core::kExitOk;
 }
 

@@ -35,12 +35,16 @@ struct CommonOptions {
   int io_threads = 1;
 };
 
-/// Adds the common options to a CLI11 app (--config is required).
-void addCommonOptions(CLI::App& app, CommonOptions& options);
+/// Whether a service takes a config file: every service but the render node, whose view file
+/// (--view) plays that part and whose network options all come from the command line.
+enum class ConfigFile { kRequired, kNone };
+
+/// Adds the common options to a CLI11 app (--config is required; absent with ConfigFile::kNone).
+void addCommonOptions(CLI::App& app, CommonOptions& options, ConfigFile config = ConfigFile::kRequired);
 
 /// A service's command line: the CLI11 app with the common options (add the service's own to `app`).
 struct Cli {
-  explicit Cli(std::string description);
+  explicit Cli(std::string description, ConfigFile config = ConfigFile::kRequired);
   CLI::App app;
   CommonOptions options;
   /// core::runMain for a service: parses, sets the --log-level, installs the stop signals, then runs
@@ -48,8 +52,8 @@ struct Cli {
   int run(int argc, char** argv, const std::function<int(const std::atomic<bool>& stop)>& body);
 };
 
-/// Loads --config (FILE:LINE on syntax errors) and applies the command-line overrides to the tree.
-/// \throws core::ConfigError.
+/// Loads --config (FILE:LINE on syntax errors) and applies the command-line overrides to the tree;
+/// without --config (ConfigFile::kNone) an empty map. \throws core::ConfigError.
 core::ConfigNode loadConfig(const CommonOptions& options, const std::function<void(YAML::Node&)>& overrides = {});
 
 /// A service's CURVE keys, from its config's `security` section (docs/cluster.md, Security):
@@ -84,8 +88,13 @@ struct Endpoints {
   std::vector<std::string> connect;
   Security security;
 };
-/// \throws core::ConfigError when there is no endpoint to publish on or the `security` section is bad.
-Endpoints resolveEndpoints(const CommonOptions& options, const core::ConfigNode& config, const std::string& default_name);
+/// Whether a service must publish: every service but a render node outside a deployment (no --publish:
+/// no publisher, no heartbeats).
+enum class Publish { kRequired, kOptional };
+/// \throws core::ConfigError when there is no endpoint to publish on (Publish::kRequired) or the
+/// `security` section is bad.
+Endpoints resolveEndpoints(const CommonOptions& options, const core::ConfigNode& config, const std::string& default_name,
+                           Publish publish = Publish::kRequired);
 
 /// The publisher of a service: its name, publish endpoints and CURVE server keys (if any).
 transport::PublisherOptions publisherOptions(const Endpoints& endpoints);
@@ -95,10 +104,12 @@ transport::SubscriberOptions subscriberOptions(const Endpoints& endpoints);
 /// The loop of every service: health RUNNING and a heartbeat at start; then, until a stop signal,
 /// `duration` seconds (0: no limit) or the iteration returning false, one iteration (which waits on its
 /// own sockets or source, up to its poll period) and a heartbeat when its period is due; at the end
-/// STOPPING and a last heartbeat.
+/// STOPPING and a last heartbeat. The duration counts from construction until run() starts, then from run().
 class ServiceLoop {
  public:
   ServiceLoop(transport::HealthReporter& health, const std::atomic<bool>& stop, double duration_s = 0.0);
+  /// `health` null: a process without heartbeats (a render node without --publish); the loop is the same.
+  ServiceLoop(transport::HealthReporter* health, const std::atomic<bool>& stop, double duration_s = 0.0);
   /// `on_heartbeat` runs after every heartbeat published (per-period statistics restart), `on_stop`
   /// once before the STOPPING heartbeat (final statistics). Returns core::kExitOk.
   int run(const std::function<bool()>& iteration, const std::function<void()>& on_heartbeat = {},
@@ -108,7 +119,7 @@ class ServiceLoop {
   double elapsed() const;  ///< s since run() started
 
  private:
-  transport::HealthReporter& health_;
+  transport::HealthReporter* health_;
   const std::atomic<bool>& stop_;
   double duration_s_;
   std::int64_t start_ns_ = 0;

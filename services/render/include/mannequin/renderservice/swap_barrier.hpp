@@ -26,7 +26,7 @@
 
 #include "mannequin/transport/publisher.hpp"
 
-namespace mannequin::render_node {
+namespace mannequin::renderservice {
 
 class SwapBarrier {
  public:
@@ -80,4 +80,4 @@ class SwapBarrier {
   Clock::time_point last_post_;
 };
 
-}  // namespace mannequin::render_node
+}  // namespace mannequin::renderservice

@@ -1,4 +1,5 @@
-#include "swap_barrier.hpp"
+// The swap barrier of synchronised render nodes over render.sync (mannequin/renderservice/swap_barrier.hpp).
+#include "mannequin/renderservice/swap_barrier.hpp"
 
 #include <spdlog/spdlog.h>
 
@@ -6,7 +7,7 @@
 
 #include "mannequin/transport/topics.hpp"
 
-namespace mannequin::render_node {
+namespace mannequin::renderservice {
 
 SwapBarrier::SwapBarrier(transport::Publisher& publisher, std::string name, double timeout_s,
                          std::function<void(std::chrono::microseconds)> poll, std::function<bool()> stopping,
@@ -141,4 +142,4 @@ std::uint64_t SwapBarrier::newestPost() const {
   return f;
 }
 
-}  // namespace mannequin::render_node
+}  // namespace mannequin::renderservice
