@@ -22,6 +22,44 @@ std::string html(const std::string& s) {
   return out;
 }
 
+/// An inline SVG line plot of y(t) (NaN breaks the line), fixed y range if lo < hi given.
+std::string plot(const std::string& title, const std::vector<double>& t, const std::vector<double>& y, double lo, double hi,
+                 const char* colour) {
+  const double W = 420, H = 160, L = 44, R = 8, T = 20, B = 24;
+  if (!(lo < hi)) {
+    lo = minOf(y), hi = maxOf(y);
+    if (!std::isfinite(lo)) lo = 0, hi = 1;
+    if (hi - lo < 1e-9) lo -= 0.5, hi += 0.5;
+  }
+  const double t0 = t.empty() ? 0 : t.front(), t1 = t.empty() || t.back() <= t0 ? t0 + 1 : t.back();
+  const auto X = [&](double v) { return L + (v - t0) / (t1 - t0) * (W - L - R); };
+  const auto Y = [&](double v) { return T + (hi - std::clamp(v, lo, hi)) / (hi - lo) * (H - T - B); };
+  std::string svg = fmt::format(
+      "<svg xmlns=\"http://www.w3.org/2000/svg\" width=\"{0}\" height=\"{1}\" viewBox=\"0 0 {0} {1}\" role=\"img\">"
+      "<title>{2}</title><text x=\"{3}\" y=\"14\" font-size=\"12\">{2}</text>"
+      "<rect x=\"{3}\" y=\"{4}\" width=\"{5}\" height=\"{6}\" fill=\"none\" stroke=\"#999\"/>"
+      "<text x=\"{7}\" y=\"{8}\" font-size=\"10\" text-anchor=\"end\">{9}</text>"
+      "<text x=\"{7}\" y=\"{10}\" font-size=\"10\" text-anchor=\"end\">{11}</text>"
+      "<text x=\"{3}\" y=\"{12}\" font-size=\"10\">{13} s</text>"
+      "<text x=\"{14}\" y=\"{12}\" font-size=\"10\" text-anchor=\"end\">{15} s</text>",
+      W, H, html(title), L, T, W - L - R, H - T - B, L - 3, T + 8, shortNum(hi, 2), H - B, shortNum(lo, 2), H - 8, shortNum(t0, 1),
+      W - R, shortNum(t1, 1));
+  std::string pts;
+  const auto flush = [&] {
+    if (!pts.empty()) svg += fmt::format("<polyline fill=\"none\" stroke=\"{}\" stroke-width=\"1.2\" points=\"{}\"/>", colour, pts);
+    pts.clear();
+  };
+  for (std::size_t i = 0; i < t.size() && i < y.size(); ++i) {
+    if (!std::isfinite(y[i])) {
+      flush();
+      continue;
+    }
+    pts += fmt::format("{}{:.1f},{:.1f}", pts.empty() ? "" : " ", X(t[i]), Y(y[i]));
+  }
+  flush();
+  return svg + "</svg>";
+}
+
 }  // namespace
 
 std::string reportHtml(const std::vector<Run>& runs, const std::string& mocap, const SnapshotInfo& shots) {

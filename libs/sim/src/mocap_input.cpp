@@ -46,10 +46,6 @@ std::int64_t World::captureTimeNs(const std::string& source) const {
          static_cast<std::int64_t>(std::llround(config_.interpolation_delay * 1e9));
 }
 
-namespace {
-constexpr double kJumpTolerance = 0.05;  // m: noise of a tracked position over a frame
-constexpr double kCatchUpSpeed = 1.0;  // m/s: a target catching up with its body after a stream gap
-}  // namespace
 
 bool World::addMocap(const mocap::Frame& in, const std::string& source) {
   Source* src = findSource(source);

@@ -27,6 +27,9 @@
 
 namespace mannequin::sim {
 
+constexpr double kJumpTolerance = 0.05;  // m: noise of a tracked position over a frame (mocap_input.cpp)
+constexpr double kCatchUpSpeed = 1.0;    // m/s: a target catching up with its body after a stream gap (drive_targets.cpp)
+
 /// max over limited coordinates of how far q is past a limit (rad, >= 0): revolute coordinates against
 /// their bounds, ball joints against their swing ellipse and twist range (diagnostics.cpp).
 double worstLimitExcess(const skeleton::Model& model, const skeleton::VectorX& q);
