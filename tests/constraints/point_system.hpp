@@ -28,10 +28,11 @@ class PointSystem final : public ConstrainedSystem {
   int nv() const override { return static_cast<int>(x.size()); }
   const Eigen::VectorXd& qdotFree() const override { return qdot_free_; }
   const mannequin::math::TreeCholesky& frictionFactor() const override { return factor_; }
-  void applyConstraintForce(const Eigen::VectorXd& gamma_c) override {
+  bool applyConstraintForce(const Eigen::VectorXd& gamma_c) override {
     applied += gamma_c;
     qdot.noalias() += (tau_ / m_) * gamma_c;
     ++applications;
+    return true;
   }
   double b() const { return m_ / tau_; }
   /// Stage 1: q̇_free = b⁻¹ Γ_ext (allocation-free).

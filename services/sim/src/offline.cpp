@@ -32,6 +32,11 @@ namespace mannequin::simservice {
 
 namespace {
 
+bool endsWith(std::string s, const std::string& suffix) {
+  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
 /// A progress bar with ETA on stderr, redrawn at most every 0.1 s.
 class Progress {
  public:
