@@ -9,6 +9,7 @@
 #include <string>
 
 #include "mannequin/skeleton/bvh.hpp"
+#include "bvh_data.hpp"
 
 namespace sk = mannequin::skeleton;
 using mannequin::math::Matrix3;
@@ -17,10 +18,7 @@ using mannequin::math::Vector3;
 
 namespace {
 
-std::string dataPath(const std::string& name) {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return std::string(root ? root : ".") + "/data/bvh/" + name;
-}
+std::string dataPath(const std::string& name) { return mannequin::testing::bvhDataPath(name); }
 
 std::string readText(const std::string& path) {
   std::ifstream in(path, std::ios::binary);

@@ -6,6 +6,7 @@
 #include <fstream>
 #include <string>
 
+#include "bvh_data.hpp"
 #include "../common/tool_run.hpp"
 
 namespace fs = std::filesystem;
@@ -16,10 +17,6 @@ using mannequin::testutil::ToolResult;
 
 fs::path toolPath() { return mannequin::testutil::binDir() / "mannequin-bvh"; }
 
-std::string dataPath(const std::string& name) {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return std::string(root ? root : ".") + "/data/bvh/" + name;
-}
 
 class ToolTest : public mannequin::testutil::TempDirTest {
  protected:
@@ -38,7 +35,8 @@ class ToolTest : public mannequin::testutil::TempDirTest {
 
 };
 
-const char* kTiny =
+// a small capture whose joint names carry a namespace prefix ("b:B")
+const char* kTinyPrefixed =
     "HIERARCHY\nROOT A\n{\n  OFFSET 1 2 3\n  CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
     "  JOINT b:B\n  {\n    OFFSET 0 1 0\n    CHANNELS 3 Xrotation Yrotation Zrotation\n"
     "    End Site\n    {\n      OFFSET 0 0 2\n    }\n  }\n}\n"
@@ -47,16 +45,16 @@ const char* kTiny =
 }  // namespace
 
 TEST_F(ToolTest, InfoJsonOnRealCaptures) {
-  ToolResult r = run("info " + dataPath("cmu_max_131_03.bvh") + " --json");
+  ToolResult r = run("info " + mannequin::testing::bvhDataPath("cmu_max_131_03.bvh") + " --json");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, "{\"joints\": 31, \"channels\": 96, \"frames\": 1102, \"frame_time\": 0.0083333, \"root\": \"Hips\"}\n");
-  r = run("info --json " + dataPath("mocapbank_test.bvh"));
+  r = run("info --json " + mannequin::testing::bvhDataPath("mocapbank_test.bvh"));
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out, "{\"joints\": 19, \"channels\": 60, \"frames\": 455, \"frame_time\": 0.033333, \"root\": \"Hips\"}\n");
 }
 
 TEST_F(ToolTest, InfoHumanReadable) {
-  const ToolResult r = run("info " + write("tiny.bvh", kTiny));
+  const ToolResult r = run("info " + write("tiny.bvh", kTinyPrefixed));
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_NE(r.out.find("joints:     2 (+ 1 End Sites)"), std::string::npos) << r.out;
   EXPECT_NE(r.out.find("b:B  offset (0, 1, 0)  [Xrotation Yrotation Zrotation]"), std::string::npos) << r.out;
@@ -64,7 +62,7 @@ TEST_F(ToolTest, InfoHumanReadable) {
 
 TEST_F(ToolTest, PosesJsonExact) {
   // hand-computed: frame 0 turns the root 90° about z, frame 1 the child 90° about x; End Sites omitted
-  const ToolResult r = run("poses " + write("tiny.bvh", kTiny) + " --frames 0,-1 --json");
+  const ToolResult r = run("poses " + write("tiny.bvh", kTinyPrefixed) + " --frames 0,-1 --json");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(r.out,
             "{\"0\": {\"A\": {\"p\": [11, 2, 3], \"R\": [[0, -1, 0], [1, 0, 0], [0, 0, 1]]}, "
@@ -72,15 +70,15 @@ TEST_F(ToolTest, PosesJsonExact) {
             "\"1\": {\"A\": {\"p\": [1, 2, 3], \"R\": [[1, 0, 0], [0, 1, 0], [0, 0, 1]]}, "
             "\"b:B\": {\"p\": [1, 3, 3], \"R\": [[1, 0, 0], [0, 0, -1], [0, 1, 0]]}}}\n");
   // a lone negative frame, repeated frames printed once under the resolved key
-  const ToolResult last = run("poses " + write("tiny2.bvh", kTiny) + " --frames -1 --json");
-  const ToolResult again = run("poses " + write("tiny3.bvh", kTiny) + " --frames=1,-1 --json");
+  const ToolResult last = run("poses " + write("tiny2.bvh", kTinyPrefixed) + " --frames -1 --json");
+  const ToolResult again = run("poses " + write("tiny3.bvh", kTinyPrefixed) + " --frames=1,-1 --json");
   EXPECT_EQ(last.exit_code, 0) << last.err;
   EXPECT_EQ(last.out.rfind("{\"1\": {\"A\": {\"p\": [1, 2, 3]", 0), 0u) << last.out;
   EXPECT_EQ(last.out, again.out);
 }
 
 TEST_F(ToolTest, PosesJsonOnRealCapture) {
-  const ToolResult r = run("poses " + dataPath("cmu_max_131_03.bvh") + " --frames 0,100,-1 --json");
+  const ToolResult r = run("poses " + mannequin::testing::bvhDataPath("cmu_max_131_03.bvh") + " --frames 0,100,-1 --json");
   EXPECT_EQ(r.exit_code, 0) << r.err;
   // the root is at offset (0,0,0) + the position channels of frame 0 (5.1723 16.9371 -29.1264)
   EXPECT_EQ(r.out.rfind("{\"0\": {\"Hips\": {\"p\": [5.1723, 16.9371, -29.1264], \"R\": [[", 0), 0u) << r.out.substr(0, 200);
@@ -94,7 +92,7 @@ TEST_F(ToolTest, PosesJsonOnRealCapture) {
 }
 
 TEST_F(ToolTest, BadCommandLinesExitTwo) {
-  const std::string tiny = write("tiny.bvh", kTiny);
+  const std::string tiny = write("tiny.bvh", kTinyPrefixed);
   const struct {
     std::string args;
     const char* message;
@@ -120,7 +118,7 @@ TEST_F(ToolTest, BadCommandLinesExitTwo) {
 }
 
 TEST_F(ToolTest, MalformedFileExitsOneWithFileAndLine) {
-  std::string broken = kTiny;
+  std::string broken = kTinyPrefixed;
   broken.replace(broken.find("0 0 0 0 0 0 90 0 0"), 18, "0 0 0 0 0 0 90 0");
   const std::string path = write("broken.bvh", broken);
   const ToolResult r = run("info " + path + " --json");

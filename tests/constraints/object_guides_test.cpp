@@ -1,5 +1,6 @@
 // Guides on objects (sim::GuideRows, thesis 4.1.1 and 4.3.1): an object kept on a virtual mechanism by
 // rows of the LCP. Each test steps free motion → solver → integration, like the World.
+#include "object_step.hpp"
 #include "mannequin/sim/object_guides.hpp"
 
 #include <gtest/gtest.h>
@@ -20,8 +21,8 @@ namespace cs = mannequin::constraints;
 namespace sim = mannequin::sim;
 namespace ctl = mannequin::control;
 
-const Vector3 kGravity(0, 0, -9.81);
-constexpr double kDt = 0.001;
+using mannequin::testing::kDt;
+using mannequin::testing::kGravity;
 
 sim::RigidObjectSpec boxSpec(const SE3& pose, double mass = 2.0) {
   sim::RigidObjectSpec s;

@@ -1,5 +1,6 @@
 // Rigid objects (sim::RigidObject), hinge limits and grasps through the ConstraintSolver (thesis 3.2,
 // 4.3.1, Fig. 3.6): each test steps free motion → solver → integration, like the World.
+#include "object_step.hpp"
 #include "mannequin/sim/rigid_object.hpp"
 
 #include <gtest/gtest.h>
@@ -22,8 +23,8 @@ using mannequin::math::Vector6;
 namespace cs = mannequin::constraints;
 namespace sim = mannequin::sim;
 
-const Vector3 kGravity(0, 0, -9.81);
-constexpr double kDt = 0.001;
+using mannequin::testing::kDt;
+using mannequin::testing::kGravity;
 
 // Contacts of points of a RigidObject with a static plane {x : n·x = offset} (the test's own producer,
 // independent of constraints::ContactRows): per point, d = n·p − offset − radius, J = nᵀ J_p(p − r n),
