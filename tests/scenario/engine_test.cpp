@@ -14,7 +14,7 @@ using namespace mannequin::scenario;
 
 namespace {
 
-const std::string kHeader = R"(scenario: t
+const std::string kEngineHeader = R"(scenario: t
 mannequins:
   - name: m
     frames: [hand, foot]
@@ -26,7 +26,7 @@ triggers: [go, stop]
 
 // two states: a → b when `when`; b: hand autonomous (goal 1 m up), back to a on trigger stop
 Scenario twoStates(const std::string& when) {
-  return parseScenario(kHeader + "states:\n  - name: a\n    transitions:\n      - to: b\n        when: " + when +
+  return parseScenario(kEngineHeader + "states:\n  - name: a\n    transitions:\n      - to: b\n        when: " + when +
                            "\n  - name: b\n    modes:\n      hand: {mode: autonomous, goal: {xyz: [0, 0, 1]}, duration_s: 0.5}\n"
                            "    transitions:\n      - {to: a, when: {trigger: stop}}\n",
                        "t.yaml");
@@ -135,7 +135,7 @@ TEST(ScenarioEngine, ReachedPoseWithinTolerance) {
 }
 
 TEST(ScenarioEngine, ReachedAutonomousGoalRelativeToObject) {
-  const Scenario s = parseScenario(kHeader + R"(states:
+  const Scenario s = parseScenario(kEngineHeader + R"(states:
   - name: a
     modes:
       hand: {mode: autonomous, goal: {xyz: [0, 0, 0.5]}, relative_to: door, duration_s: 1}
