@@ -15,4 +15,7 @@ inline std::string sourceDir() {
 /// A file of the checkout, from its path relative to the root.
 inline std::string sourcePath(const std::string& relative) { return sourceDir() + "/" + relative; }
 
+/// configs/mannequins/<file> in the checkout (e.g. "male_50th.yaml").
+inline std::string mannequinConfigPath(const std::string& file) { return sourcePath("configs/mannequins/" + file); }
+
 }  // namespace mannequin::testing

@@ -2,13 +2,14 @@
 
 #include <gtest/gtest.h>
 
+#include <numbers>
 #include <random>
 #include <unsupported/Eigen/MatrixFunctions>
 
 using namespace mannequin::math;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+using std::numbers::pi;
 
 struct Rng {
   std::mt19937 g{42};
@@ -57,7 +58,7 @@ TEST(SE3, ExpMatchesThesisClosedForm) {
 
 TEST(SE3, LogInvertsExpIncludingEdgeAngles) {
   Rng rng;
-  const double angles[] = {0.0, 1e-9, 1e-5, 1.0, kPi - 1e-9, kPi};
+  const double angles[] = {0.0, 1e-9, 1e-5, 1.0, pi - 1e-9, pi};
   for (int i = 0; i < 30; ++i) {
     const Vector3 u = rng.v3().normalized();
     const Vector3 v = rng.v3();
@@ -67,7 +68,7 @@ TEST(SE3, LogInvertsExpIncludingEdgeAngles) {
       const SE3 H = expSE3(V);
       // exp(log H) = H for every angle, including π where log has two answers
       EXPECT_TRUE(expSE3(logSE3(H)).isApprox(H, 1e-9)) << "angle " << t;
-      if (t < kPi - 1e-6) {
+      if (t < pi - 1e-6) {
         EXPECT_LT((logSE3(H) - V).norm(), 1e-8) << "angle " << t;
       }
     }

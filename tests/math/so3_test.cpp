@@ -3,12 +3,13 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <numbers>
 #include <random>
 
 using namespace mannequin::math;
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
+using std::numbers::pi;
 
 Vector3 randomUnit(std::mt19937& rng) {
   std::normal_distribution<double> n;
@@ -26,7 +27,7 @@ TEST(SO3, HatIsCrossProductAndVeeInverts) {
 
 TEST(SO3, ExpOfQuarterTurnAboutZ) {
   // hand-checked: 90° about z maps x to y
-  const Matrix3 R = expSO3(Vector3(0, 0, kPi / 2));
+  const Matrix3 R = expSO3(Vector3(0, 0, pi / 2));
   EXPECT_TRUE((R * Vector3::UnitX()).isApprox(Vector3::UnitY(), 1e-15));
   EXPECT_NEAR(R.determinant(), 1.0, 1e-15);
 }
@@ -44,7 +45,7 @@ TEST(SO3, ExpMatchesTaylorSeriesOfMatrixExponential) {
 
 TEST(SO3, LogInvertsExpOverRandomAndEdgeAngles) {
   std::mt19937 rng(7);
-  const double angles[] = {0.0, 1e-12, 1e-9, 1e-6, 1e-4, 1e-3, 0.5, 2.0, 3.0, kPi - 1e-2, kPi - 1e-6, kPi - 1e-9};
+  const double angles[] = {0.0, 1e-12, 1e-9, 1e-6, 1e-4, 1e-3, 0.5, 2.0, 3.0, pi - 1e-2, pi - 1e-6, pi - 1e-9};
   for (int trial = 0; trial < 50; ++trial) {
     const Vector3 u = randomUnit(rng);
     for (double t : angles) {
@@ -60,17 +61,17 @@ TEST(SO3, LogAtExactlyPiGivesAValidVector) {
   std::mt19937 rng(3);
   for (int trial = 0; trial < 50; ++trial) {
     const Vector3 u = randomUnit(rng);
-    const Matrix3 R = expSO3(kPi * u);
+    const Matrix3 R = expSO3(pi * u);
     const Vector3 w = logSO3(R);
-    EXPECT_NEAR(w.norm(), kPi, 1e-9);
+    EXPECT_NEAR(w.norm(), pi, 1e-9);
     // ±πu are the same rotation
-    EXPECT_LT(std::min((w - kPi * u).norm(), (w + kPi * u).norm()), 1e-7);
+    EXPECT_LT(std::min((w - pi * u).norm(), (w + pi * u).norm()), 1e-7);
     EXPECT_LT((expSO3(w) - R).norm(), 1e-12);
   }
   // the diagonal case diag(1,-1,-1): rotation by π about x
   Matrix3 Rx = Matrix3::Identity();
   Rx(1, 1) = Rx(2, 2) = -1;
-  EXPECT_TRUE(logSO3(Rx).isApprox(Vector3(kPi, 0, 0), 1e-12));
+  EXPECT_TRUE(logSO3(Rx).isApprox(Vector3(pi, 0, 0), 1e-12));
 }
 
 TEST(SO3, RightJacobianMatchesFiniteDifferences) {

@@ -30,7 +30,7 @@ mocap::Frame actor(std::int64_t stamp_ns, const math::Vector3& hand_offset) {
   return f;
 }
 
-std::vector<MannequinSetup> oneMannequin(const std::string& model_file = "configs/mannequins/male_50th.yaml") {
+std::vector<MannequinSetup> checkpointMannequin(const std::string& model_file = "configs/mannequins/male_50th.yaml") {
   MannequinSetup s;
   s.name = "operator";
   s.model = skeleton::buildMannequin(skeleton::loadMannequinSpec(model_file));
@@ -55,7 +55,7 @@ std::string checkpointBytes(const World& w) {
   return simservice::encodeCheckpoint(c);
 }
 
-std::string tempDir() {
+std::string checkpointDir() {
   const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
   auto p = std::filesystem::temp_directory_path() / ("mq-ckpt-" + std::string(info->name()) + "-" + std::to_string(getpid()));
   std::filesystem::create_directories(p);
@@ -75,19 +75,19 @@ std::string errorOf(F&& f) {
 
 TEST(SimCheckpoint, AWorldRestoredFromItsCheckpointFileIsWhereItWasAndContinuesLikeIt) {
   SimConfig cfg;
-  World original(oneMannequin(), cfg);
+  World original(checkpointMannequin(), cfg);
   drive(original);
   ASSERT_TRUE(original.calibrated(0));
   ASSERT_GT(original.q(0)(0), 1.5);  // far from the initial pose (standing at the origin)
 
-  const std::string dir = tempDir();
+  const std::string dir = checkpointDir();
   const std::string file = dir + "/sim.checkpoint";
   simservice::writeCheckpointFile(file, checkpointBytes(original));
   EXPECT_FALSE(std::filesystem::exists(file + ".tmp"));
   const v1::SimCheckpoint read = simservice::readCheckpoint(file);
   EXPECT_EQ(read.written_ns(), 123);
 
-  World restored(oneMannequin(), cfg);
+  World restored(checkpointMannequin(), cfg);
   const std::vector<std::string> notes = simservice::restoreWorld(restored, read);
   ASSERT_FALSE(notes.empty());
   EXPECT_NE(notes[0].find("velocities"), std::string::npos);
@@ -105,7 +105,7 @@ TEST(SimCheckpoint, AWorldRestoredFromItsCheckpointFileIsWhereItWasAndContinuesL
   }
 
   // no mocap yet (the restarted sim's source is not anchored): it holds the restored pose
-  World held(oneMannequin(), cfg);
+  World held(checkpointMannequin(), cfg);
   simservice::restoreWorld(held, read);
   for (int k = 0; k < 200; ++k) held.step();
   EXPECT_LT((held.q(0).head<3>() - original.q(0).head<3>()).norm(), 1e-3);
@@ -124,10 +124,10 @@ TEST(SimCheckpoint, AWorldRestoredFromItsCheckpointFileIsWhereItWasAndContinuesL
 
 TEST(SimCheckpoint, ACorruptOrMismatchedCheckpointIsRefusedNamingWhyAndTheWorldIsUnchanged) {
   SimConfig cfg;
-  World source(oneMannequin(), cfg);
+  World source(checkpointMannequin(), cfg);
   drive(source);
   const std::string bytes = checkpointBytes(source);
-  const std::string dir = tempDir();
+  const std::string dir = checkpointDir();
   const std::string file = dir + "/sim.checkpoint";
 
   // the file: missing, not a checkpoint, truncated, a flipped byte
@@ -143,7 +143,7 @@ TEST(SimCheckpoint, ACorruptOrMismatchedCheckpointIsRefusedNamingWhyAndTheWorldI
 
   // a good file that does not fit: another model, NaN, another mannequin, a missing calibration
   const v1::SimCheckpoint good = simservice::decodeCheckpoint(bytes, "test");
-  World w(oneMannequin(), cfg);
+  World w(checkpointMannequin(), cfg);
   const skeleton::VectorX q0 = w.q(0);
   const auto refused = [&](v1::SimCheckpoint c, const std::string& expected) {
     const std::string e = errorOf([&] { simservice::restoreWorld(w, c); });
@@ -172,7 +172,7 @@ TEST(SimCheckpoint, ACorruptOrMismatchedCheckpointIsRefusedNamingWhyAndTheWorldI
   c.mutable_calibration(0)->mutable_offsets(0)->mutable_pose()->mutable_position()->set_x(std::nan(""));
   refused(c, "offset");
   // another model file with the same frames: a model of another name
-  World other(oneMannequin("configs/mannequins/male_95th.yaml"), cfg);
+  World other(checkpointMannequin("configs/mannequins/male_95th.yaml"), cfg);
   EXPECT_NE(errorOf([&] { simservice::restoreWorld(other, good); }).find("model"), std::string::npos);
 
   // the service: a corrupt --resume file is logged and the sim starts fresh (no throw)

@@ -10,6 +10,7 @@
 #include <functional>
 #include <string>
 
+#include "actor.hpp"
 #include "mannequin/balance/static_balance.hpp"
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/control/config.hpp"
@@ -24,7 +25,7 @@ using namespace mannequin::sim;
 
 namespace {
 using mannequin::testing_fixture::male50;
-const char* const kBodies[] = {"pelvis", "head", "hand_l", "hand_r", "foot_l", "foot_r"};
+using mannequin::testing::kActorBodies;
 
 const skeleton::Data& standing() {
   static const skeleton::Data d = [] {
@@ -55,14 +56,14 @@ MannequinSetup worker() {
   MannequinSetup m;
   m.name = "worker";
   m.model = male50();
-  for (const char* b : kBodies) m.frames.push_back({b, b});
+  for (const char* b : kActorBodies) m.frames.push_back({b, b});
   m.controller = control::loadControllerConfig("configs/control/mocap.yaml");
   return m;
 }
 
 /// The actor's bodies at time t: standing; from 0.2 s to 1 s the left hand goes to the wall, from 1.5 s to
 /// 2.5 s the right hand reaches ahead (smoothstep); the pelvis, head and feet stay.
-mocap::Frame actorFrame(double t, const math::Vector3& wall_hand, const math::Vector3& reach) {
+mocap::Frame wallReachFrame(double t, const math::Vector3& wall_hand, const math::Vector3& reach) {
   auto smooth = [](double s) {
     s = std::clamp(s, 0.0, 1.0);
     return s * s * (3 - 2 * s);
@@ -70,7 +71,7 @@ mocap::Frame actorFrame(double t, const math::Vector3& wall_hand, const math::Ve
   mocap::Frame f;
   f.stamp_ns = static_cast<std::int64_t>(std::llround(t * 1e9)) + 1;
   f.sequence = static_cast<std::uint64_t>(f.stamp_ns / 1000000 + 1);
-  for (const char* b : kBodies) {
+  for (const char* b : kActorBodies) {
     math::SE3 T = standing().oMf[static_cast<std::size_t>(male50().frameIndex(b))];
     if (std::string(b) == "hand_l") T.p += smooth((t - 0.2) / 0.8) * (wall_hand - T.p);
     if (std::string(b) == "hand_r") T.p += smooth(t - 1.5) * (reach - T.p);
@@ -125,14 +126,14 @@ WorkerRun runWorker(bool balance, double push, const math::Vector3& wall_hand, c
   std::vector<MannequinSetup> setups;
   setups.push_back(worker());
   World w(std::move(setups), cfg);
-  w.addMocap(actorFrame(0, wall_hand, reach));
+  w.addMocap(wallReachFrame(0, wall_hand, reach));
   w.anchor(1);
   EXPECT_TRUE(w.calibrated(0));
   WorkerRun run;
   math::Vector3 feet0[2] = {at(w.data(0), kFootL), at(w.data(0), kFootR)};
   for (long k = 0; k < 4000; ++k) {
     const double t = static_cast<double>(k) * 1e-3;
-    if (k % 10 == 0) w.addMocap(actorFrame(t, wall_hand, reach));
+    if (k % 10 == 0) w.addMocap(wallReachFrame(t, wall_hand, reach));
     EXPECT_TRUE(w.step()) << "step " << k;
     if (k == 300) {
       run.early = w.mannequinDiagnostics(0);
@@ -223,7 +224,7 @@ TEST(WorldBalanceController, InTheAirItLetsGoAndReportsItThenTakesOverAgain) {
   World w(std::move(setups), cfg);
   const math::Vector3 still = standingPosition("hand_l"), still_r = standingPosition("hand_r");
   auto frame = [&](double t, double lift) {
-    mocap::Frame f = actorFrame(0, still, still_r);
+    mocap::Frame f = wallReachFrame(0, still, still_r);
     f.stamp_ns = static_cast<std::int64_t>(std::llround(t * 1e9)) + 1;
     f.sequence = static_cast<std::uint64_t>(f.stamp_ns / 1000000 + 1);
     for (mocap::Body& b : f.bodies) b.pose.p.z() += lift;

@@ -11,6 +11,7 @@
 #include <limits>
 #include <map>
 
+#include "actor.hpp"
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/control/config.hpp"
 #include "mannequin/math/so3.hpp"
@@ -27,14 +28,14 @@ using namespace mannequin::sim;
 namespace {
 using mannequin::testing_fixture::male50;
 
-const char* const kBodies[] = {"pelvis", "head", "hand_l", "hand_r", "foot_l", "foot_r"};
+using mannequin::testing::kActorBodies;
 
 MannequinSetup actorSetup(const std::string& name, const std::string& source) {
   MannequinSetup m;
   m.name = name;
   m.model = male50();
   m.mocap_source = source;
-  for (const char* b : kBodies) m.frames.push_back({b, b});
+  for (const char* b : kActorBodies) m.frames.push_back({b, b});
   m.controller = control::loadControllerConfig("configs/control/mocap.yaml");
   return m;
 }
@@ -50,7 +51,7 @@ mocap::Frame actorFrame(std::int64_t stamp_ns, const math::SE3& base, const std:
   mocap::Frame f;
   f.stamp_ns = stamp_ns;
   f.sequence = static_cast<std::uint64_t>(stamp_ns / 1000000 + 1);
-  for (const char* b : kBodies) {
+  for (const char* b : kActorBodies) {
     math::SE3 T = base * standing.oMf[static_cast<std::size_t>(male50().frameIndex(b))];
     if (auto it = moved.find(b); it != moved.end()) T.p = it->second;
     f.bodies.push_back({b, T, true});
@@ -74,7 +75,7 @@ double smooth(double s) {
   return s * s * (3 - 2 * s);
 }
 
-SimConfig physicsConfig(const std::string& scene_yaml) {
+SimConfig physicsConfigOfScene(const std::string& scene_yaml) {
   SimConfig c;
   c.physics.enabled = true;
   c.physics.scene = collision::parseScene(scene_yaml, "test-scene.yaml");
@@ -111,7 +112,7 @@ double normalForceOn(const World& w, int body) {
 TEST(WorldPhysics, StandingBalanceDistanceIsPositiveInsideTheFeet) {
   std::vector<MannequinSetup> setups;
   setups.push_back(actorSetup("operator", ""));
-  World w(std::move(setups), physicsConfig("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"));
+  World w(std::move(setups), physicsConfigOfScene("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"));
   const math::SE3 base = placed(0, 0, 0);
   w.addMocap(actorFrame(0, base));
   w.anchor(0);
@@ -135,7 +136,7 @@ TEST(WorldPhysics, StandingBalanceDistanceIsPositiveInsideTheFeet) {
 TEST(WorldPhysics, TheForceMarginOfAStandingMannequinIsBelowStaticsBoundsAndZeroInTheAir) {
   std::vector<MannequinSetup> setups;
   setups.push_back(actorSetup("operator", ""));
-  SimConfig cfg = physicsConfig("friction: {default: 0.8}\nbodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n");
+  SimConfig cfg = physicsConfigOfScene("friction: {default: 0.8}\nbodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n");
   cfg.physics.force_margin_period = 0.05;
   World w(std::move(setups), cfg);
   EXPECT_TRUE(std::isnan(w.mannequinDiagnostics(0).force_margin_n)) << "not evaluated before calibration";
@@ -218,7 +219,7 @@ TEST(WorldPhysics, AHandDrivenIntoATableStopsOnIt) {
                 top - 0.02);
   std::vector<MannequinSetup> setups;
   setups.push_back(actorSetup("operator", ""));
-  World w(std::move(setups), physicsConfig(scene));
+  World w(std::move(setups), physicsConfigOfScene(scene));
   const math::SE3 base = placed(0, 0, 0);
   const math::Vector3 hang = standingFrame(base, "hand_r").p;
   // the hand hangs fingers down (standing orientation): up in front of the body first, then over the
@@ -277,7 +278,7 @@ TEST(WorldPhysics, TwoMannequinsLiftABoxByItsHandlesAndCarryIt1m) {
   std::vector<MannequinSetup> setups;
   setups.push_back(actorSetup("alice", "rig_a"));
   setups.push_back(actorSetup("bob", "rig_b"));
-  World w(std::move(setups), physicsConfig(scene));
+  World w(std::move(setups), physicsConfigOfScene(scene));
   ASSERT_EQ(w.mocapSources().size(), 3u);  // "" and the two rigs
   const int box = w.findObject("box");
   ASSERT_GE(box, 0);
@@ -427,7 +428,7 @@ TEST(WorldPhysics, SixtySecondsWithBothHandsOnATableKeepTheEnergyBounded) {
       "  - name: table\n    pose: {position: [0.45, 0, 0.83]}\n    shape: {type: box, size: [0.3, 0.8, 0.04]}\n";
   std::vector<MannequinSetup> setups;
   setups.push_back(actorSetup("operator", ""));
-  World w(std::move(setups), physicsConfig(scene));
+  World w(std::move(setups), physicsConfigOfScene(scene));
   const math::SE3 base = placed(0, 0, 0);
   std::map<std::string, math::Vector3> hang, up, on;
   for (const char* h : {"hand_l", "hand_r"}) {
@@ -508,7 +509,7 @@ TEST(WorldPhysics, TwoMannequinsReachingForTheSamePointStopEachOther) {
   std::vector<MannequinSetup> setups;
   setups.push_back(actorSetup("alice", "rig_a"));
   setups.push_back(actorSetup("bob", "rig_b"));
-  World w(std::move(setups), physicsConfig("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"));
+  World w(std::move(setups), physicsConfigOfScene("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"));
   const math::SE3 base_a = placed(-0.5, 0, 0), base_b = placed(0.5, 0, M_PI);
   // alice's right hand and bob's left hand (both at −y) each aim 10 cm past the middle
   const math::Vector3 goal_a(0.10, -0.2, 1.15), goal_b(-0.10, -0.2, 1.15);
@@ -548,7 +549,7 @@ TEST(WorldPhysics, AMannequinNotYetCalibratedTouchesOnlyTheStaticScene) {
   std::vector<MannequinSetup> setups;
   setups.push_back(actorSetup("alice", "rig_a"));
   setups.push_back(actorSetup("bob", "rig_b"));
-  World w(std::move(setups), physicsConfig("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"));
+  World w(std::move(setups), physicsConfigOfScene("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n"));
   const math::SE3 base = placed(0, 0, 0);
   const auto feed = [&](double t) { w.addMocap(actorFrame(ns(t) + 1, base), "rig_a"); };
   feed(0);
@@ -589,7 +590,7 @@ TEST(WorldPhysics, SelfContactsStopTwoHandsDrivenThroughEachOther) {
   const auto drive = [](bool self_collision) {
     std::vector<MannequinSetup> setups;
     setups.push_back(actorSetup("operator", ""));
-    SimConfig cfg = physicsConfig("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n");
+    SimConfig cfg = physicsConfigOfScene("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n");
     cfg.physics.self_collision = self_collision;
     World w(std::move(setups), cfg);
     const math::SE3 base = placed(0, 0, 0);
@@ -638,7 +639,7 @@ TEST(WorldPhysics, BalanceRowsKeepALeaningMannequinsCoMOverItsFeet) {
   const auto lean = [](bool rows) {
     std::vector<MannequinSetup> setups;
     setups.push_back(actorSetup("operator", ""));
-    SimConfig cfg = physicsConfig("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n");
+    SimConfig cfg = physicsConfigOfScene("bodies:\n  - name: floor\n    shape: {type: plane, normal: [0, 0, 1], offset: 0}\n");
     cfg.physics.balance_rows = rows;
     cfg.physics.balance.inscribed = true;  // the row's ellipse inside the polygon (the thesis's encloses it)
     World w(std::move(setups), cfg);
@@ -812,7 +813,7 @@ TEST(WorldScenario, AttachGuideHoldsATrayLevelAndDetachGuideLetsItFall) {
       "    hinge: {axis: [0, 0, 1], point: [2.0, 0.45, 0], limits_deg: [0, 90]}\n    shape: {type: box, size: [0.04, 0.9, 2.0]}\n";
   std::vector<MannequinSetup> setups;
   setups.push_back(actorSetup("operator", ""));
-  World w(std::move(setups), physicsConfig(scene));
+  World w(std::move(setups), physicsConfigOfScene(scene));
   const int tray = w.findObject("tray");
   ASSERT_GE(tray, 0);
   const std::string head = "scenario: tray\nmannequins:\n  - name: operator\n    frames: [hand_r]\n";

@@ -1,3 +1,4 @@
+#include "../common/source.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
 #include <gtest/gtest.h>
@@ -13,10 +14,7 @@ using mannequin::core::ConfigError;
 namespace {
 constexpr double kDeg = 3.14159265358979323846 / 180.0;
 
-std::string configPath(const std::string& name) {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return std::string(root ? root : ".") + "/configs/mannequins/" + name;
-}
+using mannequin::testing::mannequinConfigPath;
 
 std::string configError(const std::string& yaml) {
   try {
@@ -42,7 +40,7 @@ struct Built {
 TEST(Anthropometry, ShippedConfigsBuildWithTheirStatureAndMass) {
   for (const char* file : {"female_05th.yaml", "male_50th.yaml", "male_95th.yaml"}) {
     SCOPED_TRACE(file);
-    const MannequinSpec spec = loadMannequinSpec(configPath(file));
+    const MannequinSpec spec = loadMannequinSpec(mannequinConfigPath(file));
     Built b(spec);
     EXPECT_NEAR(b.m.totalMass(), spec.mass, 1e-9);  // de Leva fractions sum to 1
     b.at(standingConfiguration(b.m));

@@ -2,6 +2,7 @@
 // the document is well-formed XML with one body and one joint per joint of the tree and the segments'
 // masses; with MuJoCo (MANNEQUIN_HAVE_MUJOCO): MuJoCo loads it, its sizes and total mass match ours,
 // and its forward kinematics at our standing configuration (mjcfQpos) puts every body where ours does.
+#include "../common/source.hpp"
 #include "mannequin/skeleton/mjcf.hpp"
 
 #include <gtest/gtest.h>
@@ -28,10 +29,7 @@ using namespace mannequin::skeleton;
 
 namespace {
 
-std::string configPath(const std::string& name) {
-  const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
-  return std::string(root ? root : ".") + "/configs/mannequins/" + name;
-}
+using mannequin::testing::mannequinConfigPath;
 
 /// One element of a minimal XML reader (no text content, no entities beyond attribute values: what
 /// toMjcf writes), enough to check nesting and read attributes.
@@ -173,7 +171,7 @@ int massless(const Model& m) {
 }  // namespace
 
 TEST(Mjcf, MannequinIsWellFormedWithTheModelsJointsAndMass) {
-  const Model model = buildMannequin(loadMannequinSpec(configPath("male_50th.yaml")));
+  const Model model = buildMannequin(loadMannequinSpec(mannequinConfigPath("male_50th.yaml")));
   const MjcfOptions opt;
   std::string error;
   const Element doc = parseXml(toMjcf(model, opt), error);
@@ -223,7 +221,7 @@ TEST(Mjcf, RandomTreeNestsBodiesAsTheJointTree) {
 }
 
 TEST(Mjcf, QposHasAQuaternionPerBallAndTheFreeFlyersPose) {
-  const Model model = buildMannequin(loadMannequinSpec(configPath("male_50th.yaml")));
+  const Model model = buildMannequin(loadMannequinSpec(mannequinConfigPath("male_50th.yaml")));
   const VectorX q = standingConfiguration(model);
   const std::vector<double> qpos = mjcfQpos(model, q);
   int balls = 0;
@@ -253,7 +251,7 @@ mjModel* loadMujoco(const std::string& xml, std::string& error) {
 }  // namespace
 
 TEST(MjcfMujoco, LoadsWithOurSizesMassAndForwardKinematics) {
-  const Model model = buildMannequin(loadMannequinSpec(configPath("male_50th.yaml")));
+  const Model model = buildMannequin(loadMannequinSpec(mannequinConfigPath("male_50th.yaml")));
   const MjcfOptions opt;
   std::string error;
   mjModel* m = loadMujoco(toMjcf(model, opt), error);
