@@ -77,12 +77,6 @@ const MannequinDiagnostics& World::mannequinDiagnostics(int m) const {
 
 World::~World() = default;
 
-void World::trigger(const std::string& name, const std::string& value) {
-  if (scenario_) scenario_->pending.push_back({name, value});
-}
-
-const scenario::Engine* World::scenarioEngine() const { return scenario_ ? scenario_->engine.get() : nullptr; }
-long World::scenarioUnappliedActions() const { return scenario_ ? scenario_->unapplied : 0; }
 
 const std::string& World::name(int m) const { return mannequins_.at(m)->name; }
 const skeleton::Model& World::model(int m) const { return mannequins_.at(m)->model; }
