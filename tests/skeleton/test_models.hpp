@@ -13,6 +13,12 @@ inline Model makeRandomTree(unsigned seed, int njoints = 12) {
   std::normal_distribution<double> n;
   std::uniform_real_distribution<double> u(0.1, 2.0);
   auto v3 = [&] { return Vector3(n(g), n(g), n(g)); };
+  // prefix + number, appended (GCC 12 warns falsely of -Wrestrict on "literal" + std::to_string at -O3)
+  const auto named = [](const char* prefix, int i) {
+    std::string out = prefix;
+    out += std::to_string(i);
+    return out;
+  };
   Model m;
   m.name = "random";
   m.addJoint("root", JointType::kFreeFlyer, -1, SE3::Identity());
@@ -20,17 +26,17 @@ inline Model makeRandomTree(unsigned seed, int njoints = 12) {
     std::uniform_int_distribution<int> parent(0, i - 1);
     const SE3 placement(math::expSO3(v3()), 0.3 * v3());
     const JointType type = (i % 3 == 0) ? JointType::kBall : JointType::kRevolute;
-    m.addJoint("j" + std::to_string(i), type, parent(g), placement, v3());
+    m.addJoint(named("j", i), type, parent(g), placement, v3());
   }
   for (int i = 0; i < njoints; ++i) {
     Segment s;
-    s.name = "s" + std::to_string(i);
+    s.name = named("s", i);
     s.joint = i;
     s.mass = u(g);
     s.com = 0.2 * v3();
     s.inertia = Matrix3::Identity() * 0.01;
     m.addSegment(s);
-    m.addFrame("f" + std::to_string(i), i, SE3(math::expSO3(v3()), 0.2 * v3()));
+    m.addFrame(named("f", i), i, SE3(math::expSO3(v3()), 0.2 * v3()));
   }
   return m;
 }
