@@ -69,27 +69,24 @@ std::string runJson(const Run& r) {
                        num(e.hand_force_samples ? e.hand_load_max_kg[static_cast<std::size_t>(side)] : kNaN));
   };
   return fmt::format(
-      "{{\"mannequin_config\": {}, \"label\": {}, \"mannequin\": {}, \"mcap\": {}, \"frames\": {}, \"steps\": {}, \"sim_time_s\": {}, "
-      "\"samples\": {}, \"nan_steps\": {}, \"lcp_failures\": {}, "
+      "{{\"mannequin_config\": {}, \"label\": {}, \"mannequin\": {}, \"mcap\": {}, {}, "
+      "\"samples\": {}, "
       "\"tracking_error\": {{\"per_control_frame\": {}, \"mean_m\": {}, \"max_m\": {}}}, "
-      "\"max_penetration_m\": {}, \"min_balance_distance_m\": {}, \"max_contacts\": {}, \"mean_contacts\": {}, "
-      "\"foot_contact_fraction\": {}, "
       "\"contact_force_n\": {{\"mean\": {}, \"max\": {}, \"p95\": {}}}, "
       "\"rula\": {}, \"rula_time_at_action_level_s\": [{}], \"reba\": {}, \"reba_time_at_action_level_s\": [{}], "
       "\"rula_time_at_or_above_action_level_s\": [{}], \"reba_time_at_or_above_action_level_s\": [{}], "
-      "\"hand_force_n\": {{\"left\": {}, \"right\": {}}}, \"min_force_margin_n\": {}, "
+      "\"hand_force_n\": {{\"left\": {}, \"right\": {}}}, "
       "\"series\": {{\"time_s\": {}, \"rula\": {}, \"reba\": {}, \"balance_distance_m\": {}, \"contacts\": {}, \"contact_force_n\": {}, "
       "\"penetration_m\": {}, \"tracking_error_m\": {}, \"hand_force_l_n\": {}, \"hand_force_r_n\": {}}}, \"snapshots\": {}, \"reach\": {}, "
-      "\"wall_s\": {}, \"realtime_factor\": {}, \"time_per_step_us\": {{\"mean\": {}, \"max\": {}}}}}",
-      core::jsonString(r.config), core::jsonString(r.label), core::jsonString(e.mannequin), core::jsonString(r.mcap), s.frames, s.steps,
-      num(s.sim_time_s), e.samples, s.nan_steps, s.lcp_failures, frames, num(mean(r.tracking)), num(maxOf(r.tracking)),
-      num(s.max_penetration_m), num(s.min_balance_distance_m), s.max_contacts, num(s.meanContacts()), num(s.footContactFraction()),
+      "\"time_per_step_us\": {{\"mean\": {}, \"max\": {}}}}}",
+      core::jsonString(r.config), core::jsonString(r.label), core::jsonString(e.mannequin), core::jsonString(r.mcap),
+      simservice::summaryJsonMembers(s), e.samples, frames, num(mean(r.tracking)), num(maxOf(r.tracking)),
       num(mean(r.force)), num(maxOf(r.force)), num(percentile(r.force, 0.95)),
       scoreJson(r.rula_all, r.rula_hist.data(), 7, maxOf(r.rula), mean(r.rula)), levels_rula,
       scoreJson(r.reba_all, r.reba_hist.data(), 15, maxOf(r.reba), mean(r.reba)), levels_reba, above_rula, above_reba, hand(0), hand(1),
-      num(s.min_force_margin_n), series(r.t), series(r.rula),
+      series(r.t), series(r.rula),
       series(r.reba), series(r.balance), series(r.contacts), series(r.force), series(r.penetration), series(r.tracking), series(r.hand_l), series(r.hand_r), shots, reach,
-      num(s.wall_s), num(s.realtimeFactor()), num(r.step_n ? 1e6 * r.step_wall_sum / static_cast<double>(r.step_n) : kNaN),
+      num(r.step_n ? 1e6 * r.step_wall_sum / static_cast<double>(r.step_n) : kNaN),
       num(1e6 * r.step_wall_max));
 }
 

@@ -50,20 +50,14 @@ std::string scenarioJson(const Summary& s) {
 
 void printJson(const Summary& s) {
   std::printf(
-      "{\"frames\": %lld, \"steps\": %lld, \"sim_time_s\": %s, \"wall_s\": %s, \"realtime_factor\": %s, "
-      "\"physics\": %s, \"nan_steps\": %lld, \"lcp_failures\": %lld, \"max_penetration_m\": %s, \"max_contacts\": %d, "
-      "\"mean_contacts\": %s, \"foot_contact_fraction\": %s, \"min_balance_distance_m\": %s, "
-      "\"worst_joint_limit_excess_rad\": %s, \"min_force_margin_n\": %s, \"mean_force_margin_n\": %s, "
+      "{%s, \"physics\": %s, \"worst_joint_limit_excess_rad\": %s, \"mean_force_margin_n\": %s, "
       "\"balance_controller\": {\"enabled\": %s, \"solves\": %lld, \"failures\": %lld, \"driving_fraction\": %s, "
       "\"full_margin_fraction\": %s}, "
       "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld, \"ergonomics\": %s, \"scenario\": %s}\n",
-      s.frames, s.steps, num(s.sim_time_s).c_str(), num(s.wall_s).c_str(), num(s.realtimeFactor()).c_str(),
-      s.physics ? "true" : "false", s.nan_steps, s.lcp_failures, num(s.max_penetration_m).c_str(), s.max_contacts,
-      num(s.meanContacts()).c_str(), num(s.footContactFraction()).c_str(), num(s.min_balance_distance_m).c_str(),
-      num(s.worst_joint_limit_excess_rad).c_str(), num(s.min_force_margin_n).c_str(), num(s.meanForceMargin()).c_str(),
-      s.balance_controller ? "true" : "false", s.balance_solves, s.balance_failures, num(s.balanceDrivingFraction()).c_str(),
-      num(s.balanceFullMarginFraction()).c_str(), num(s.meanHandError()).c_str(), num(s.meanFootError()).c_str(),
-      s.worlds, ergonomicsJson(s).c_str(), scenarioJson(s).c_str());
+      simservice::summaryJsonMembers(s).c_str(), s.physics ? "true" : "false", num(s.worst_joint_limit_excess_rad).c_str(),
+      num(s.meanForceMargin()).c_str(), s.balance_controller ? "true" : "false", s.balance_solves, s.balance_failures,
+      num(s.balanceDrivingFraction()).c_str(), num(s.balanceFullMarginFraction()).c_str(), num(s.meanHandError()).c_str(),
+      num(s.meanFootError()).c_str(), s.worlds, ergonomicsJson(s).c_str(), scenarioJson(s).c_str());
 }
 
 void printHuman(const Summary& s, const std::string& out) {

@@ -175,6 +175,17 @@ class RecordedCapture : public mocap::Source {
 
 }  // namespace
 
+std::string summaryJsonMembers(const OfflineSummary& s) {
+  const auto num = [](double v) { return std::isfinite(v) ? fmt::format("{:.17g}", v) : std::string("null"); };
+  return fmt::format(
+      "\"frames\": {}, \"steps\": {}, \"sim_time_s\": {}, \"wall_s\": {}, \"realtime_factor\": {}, \"nan_steps\": {}, "
+      "\"lcp_failures\": {}, \"max_penetration_m\": {}, \"max_contacts\": {}, \"mean_contacts\": {}, "
+      "\"foot_contact_fraction\": {}, \"min_balance_distance_m\": {}, \"min_force_margin_n\": {}",
+      s.frames, s.steps, num(s.sim_time_s), num(s.wall_s), num(s.realtimeFactor()), s.nan_steps, s.lcp_failures,
+      num(s.max_penetration_m), s.max_contacts, num(s.meanContacts()), num(s.footContactFraction()),
+      num(s.min_balance_distance_m), num(s.min_force_margin_n));
+}
+
 OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
   try {
     config_ = loadSimConfig(core::findData(options.config));

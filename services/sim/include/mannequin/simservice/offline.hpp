@@ -72,6 +72,13 @@ struct OfflineSummary : sim::RunTotals {
   double realtimeFactor() const { return wall_s > 0 ? sim_time_s / wall_s : kNaN; }
 };
 
+/// The figures of a run that every summary carries (mannequin-simulate --json, mannequin-batch's
+/// summary.json), as JSON members without the braces: "frames", "steps", "sim_time_s", "wall_s",
+/// "realtime_factor", "nan_steps", "lcp_failures", "max_penetration_m", "max_contacts", "mean_contacts",
+/// "foot_contact_fraction", "min_balance_distance_m", "min_force_margin_n". Numbers with 17 significant
+/// digits (the same double prints the same text), null when not finite.
+std::string summaryJsonMembers(const OfflineSummary& s);
+
 /// A bad input file (config, mannequin, scene, capture, a non-finite sample): the message names the
 /// FILE (and line or frame). Tools exit 2 on it.
 class OfflineInputError : public std::runtime_error {
