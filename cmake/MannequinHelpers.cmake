@@ -11,8 +11,17 @@ endif()
 if(MANNEQUIN_WERROR)
   target_compile_options(mannequin_options INTERFACE -Werror)
 endif()
+# The test executables' own code (property MANNEQUIN_TEST_CODE) gets MANNEQUIN_SANITIZE_TEST_CODE, the
+# rest MANNEQUIN_SANITIZE; every executable links all of MANNEQUIN_SANITIZE's runtimes.
 if(MANNEQUIN_SANITIZE)
-  target_compile_options(mannequin_options INTERFACE -fsanitize=${MANNEQUIN_SANITIZE} -fno-omit-frame-pointer -fno-sanitize-recover=all)
+  if(NOT DEFINED MANNEQUIN_SANITIZE_TEST_CODE OR MANNEQUIN_SANITIZE_TEST_CODE STREQUAL "")
+    set(MANNEQUIN_SANITIZE_TEST_CODE ${MANNEQUIN_SANITIZE})
+  endif()
+  string(REPLACE "," "$<COMMA>" test_code_sanitizers "${MANNEQUIN_SANITIZE_TEST_CODE}")
+  string(REPLACE "," "$<COMMA>" sanitizers "${MANNEQUIN_SANITIZE}")
+  target_compile_options(mannequin_options INTERFACE
+    $<IF:$<BOOL:$<TARGET_PROPERTY:MANNEQUIN_TEST_CODE>>,-fsanitize=${test_code_sanitizers},-fsanitize=${sanitizers}>
+    -fno-omit-frame-pointer -fno-sanitize-recover=all)
   target_link_options(mannequin_options INTERFACE -fsanitize=${MANNEQUIN_SANITIZE})
 endif()
 # A checking build: EIGEN_RUNTIME_NO_MALLOC lets a test forbid Eigen heap allocations in a hot loop
@@ -34,18 +43,40 @@ function(mannequin_add_library name)
   target_link_libraries(mannequin_${name} PUBLIC ${ARG_DEPS} mannequin_options PRIVATE ${ARG_PRIVATE_DEPS})
 endfunction()
 
-# mannequin_add_test(<name> SOURCES ... LIBS ... LABELS ...)
+# mannequin_add_test(<name> SOURCES ... [LIBS ...] LABELS ... [TOOLS ...] [SYSTEM] [RUN_SERIAL] [TIMEOUT s])
 # One GoogleTest executable; each test case becomes a ctest test carrying LABELS.
+# A test of a library area (MANNEQUIN_LIBRARY_TEST_AREAS, tests/CMakeLists.txt) is a library test: it runs
+# in-process, and tools/test runs it under ASan+UBSan. TOOLS names the project's executables it runs as
+# processes (built before it; MANNEQUIN_BIN_DIR is their directory): such a test, like one marked SYSTEM and
+# every test outside the library areas, is a system test. MANNEQUIN_TESTS says which kinds are built; the
+# executable of a kind not built is not created (`if(TARGET ...)` guards what follows a call).
 function(mannequin_add_test name)
   # RUN_SERIAL: no other test runs beside this one's tests (tests that start many processes and whose
   # timing claims a starved host would break)
-  cmake_parse_arguments(ARG "RUN_SERIAL" "TIMEOUT" "SOURCES;LIBS;LABELS" ${ARGN})
+  cmake_parse_arguments(ARG "RUN_SERIAL;SYSTEM" "TIMEOUT" "SOURCES;LIBS;LABELS;TOOLS" ${ARGN})
+  get_filename_component(area ${CMAKE_CURRENT_SOURCE_DIR} NAME)
+  set(kind system)
+  if(area IN_LIST MANNEQUIN_LIBRARY_TEST_AREAS AND NOT ARG_SYSTEM AND NOT ARG_TOOLS)
+    set(kind library)
+  endif()
+  if((MANNEQUIN_TESTS STREQUAL "libraries" AND kind STREQUAL "system") OR
+     (MANNEQUIN_TESTS STREQUAL "system" AND kind STREQUAL "library"))
+    return()
+  endif()
   add_executable(${name} ${ARG_SOURCES})
   target_link_libraries(${name} PRIVATE ${ARG_LIBS} mannequin_options GTest::gtest GTest::gtest_main)
-  # The test code itself is compiled at -O1 in Release (the libraries it tests stay at -O3): GoogleTest and
-  # Eigen in test sources take a large share of the build at -O3, for harness code that does little work.
-  target_compile_options(${name} PRIVATE $<$<CONFIG:Release>:-O1>)
-  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin/tests)
+  target_compile_options(${name} PRIVATE ${MANNEQUIN_TEST_CODE_FLAGS})
+  set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin/tests
+                                           MANNEQUIN_TEST_CODE ON)
+  add_dependencies(all-tests ${name})
+  foreach(tool ${ARG_TOOLS})
+    if(TARGET ${tool})
+      add_dependencies(${name} ${tool})
+    endif()
+  endforeach()
+  if(ARG_TOOLS)
+    target_compile_definitions(${name} PRIVATE MANNEQUIN_BIN_DIR="${CMAKE_BINARY_DIR}/bin")
+  endif()
   if(NOT ARG_TIMEOUT)
     set(ARG_TIMEOUT 300)
   endif()
@@ -81,7 +112,7 @@ function(mannequin_add_tool tool)
   cmake_parse_arguments(ARG "" "" "SOURCES;LIBS" ${ARGN})
   add_executable(mannequin-${tool} ${ARG_SOURCES})
   target_link_libraries(mannequin-${tool} PRIVATE ${ARG_LIBS} mannequin_options)
-  # a tool's own sources (command line, file formats, reports) at -O1 in Release: its numerical work is
-  # in the libraries it links, which stay at -O3
-  target_compile_options(mannequin-${tool} PRIVATE $<$<CONFIG:Release>:-O1>)
+  # a tool's own sources (command line, file formats, reports) are harness code: its numerical work is in
+  # the libraries it links, which keep the build type's flags
+  target_compile_options(mannequin-${tool} PRIVATE ${MANNEQUIN_TEST_CODE_FLAGS})
 endfunction()

@@ -1,34 +1,35 @@
 #pragma once
-// Counts heap allocations by interposing malloc (glibc). Include it in ONE translation unit of a test
-// executable (it defines malloc). Without AddressSanitizer only: ASan owns malloc, so there
-// countAllocations runs f and returns −1 (tests skip).
-#include <cstddef>
+// Counts heap allocations while a function runs. A test executable that counts lists
+// tests/common/alloc_counter.cpp among its sources (it defines the counter, and malloc):
+// - without AddressSanitizer it interposes malloc (glibc): operator new and Eigen's allocations go through it;
+// - under AddressSanitizer (which owns malloc) it installs an allocator hook
+//   (__sanitizer_install_malloc_and_free_hooks) that ASan's allocator calls for every allocation.
+// countAllocations returns −1 (and the tests skip) only when the hook could not be installed.
 
-#if !defined(__SANITIZE_ADDRESS__)
-namespace {
-long g_allocations = 0;
-bool g_counting = false;
-}  // namespace
-extern "C" void* __libc_malloc(std::size_t size);
-extern "C" void* malloc(std::size_t size) {
-  if (g_counting) ++g_allocations;
-  return __libc_malloc(size);
-}
-#endif
+namespace mannequin::testutil {
 
-namespace {
-/// Allocations made while f runs (−1 under AddressSanitizer).
+/// Allocations counted since the last reset, and whether counting is on (alloc_counter.cpp).
+extern long g_allocations;
+extern bool g_counting;
+
+/// Whether countAllocations counts (false only when the sanitizer hook could not be installed).
+bool allocationsCountable();
+
+/// Allocations made while f runs (−1 when they cannot be counted).
 template <class F>
 long countAllocations(F&& f) {
-#if !defined(__SANITIZE_ADDRESS__)
+  if (!allocationsCountable()) {
+    f();
+    return -1;
+  }
   g_allocations = 0;
   g_counting = true;
   f();
   g_counting = false;
   return g_allocations;
-#else
-  f();
-  return -1;
-#endif
 }
-}  // namespace
+
+}  // namespace mannequin::testutil
+
+using mannequin::testutil::allocationsCountable;
+using mannequin::testutil::countAllocations;

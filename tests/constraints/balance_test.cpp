@@ -307,6 +307,6 @@ TEST(BalanceRows, NoAllocationPerStep) {
       set.clear();
     }
   });
-  if (n < 0) GTEST_SKIP() << "AddressSanitizer owns malloc";
+  if (n < 0) GTEST_SKIP() << "the sanitizer allocator hook could not be installed";
   EXPECT_EQ(n, 0);
 }

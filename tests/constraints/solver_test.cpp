@@ -87,7 +87,7 @@ TEST(ConstraintSolver, FrictionConeOnASlope) {
   const Eigen::Vector3d n(-std::sin(a), 0.0, std::cos(a));
   for (const int edges : {4, 8}) {
     for (const double mu : {0.8, 0.2}) {
-      SCOPED_TRACE(testing::Message() << "edges " << edges << " mu " << mu);
+      SCOPED_TRACE(::testing::Message() << "edges " << edges << " mu " << mu);
       PointSystem p(3, 1, m, tau);
       PlaneProducer plane(p, 0, n, mu, edges);
       SolverOptions o;
@@ -465,7 +465,7 @@ TEST(ConstraintSolver, WarmStartAnswersSteadyStepsWithTheColdMotion) {
   const double m = 3.0, tau = 0.05, dt = 0.005, a = 20.0 * std::numbers::pi / 180.0;
   const Eigen::Vector3d n(-std::sin(a), 0.0, std::cos(a));
   for (const double mu : {0.8, 0.2}) {
-    SCOPED_TRACE(testing::Message() << "mu " << mu);
+    SCOPED_TRACE(::testing::Message() << "mu " << mu);
     PointSystem warm_p(3, 1, m, tau), cold_p(3, 1, m, tau);
     PlaneProducer warm_plane(warm_p, 0, n, mu, 4), cold_plane(cold_p, 0, n, mu, 4);
     SolverOptions o;

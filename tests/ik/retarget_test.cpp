@@ -1,4 +1,4 @@
-// Retargeting a real capture onto mannequins of other sizes, the BVH writer, and the tool.
+// Retargeting a real capture onto mannequins of other sizes, and the BVH writer (the tool: retarget_tool_test.cpp).
 #include <gtest/gtest.h>
 
 #include <cstdio>
@@ -108,28 +108,6 @@ TEST(Retarget, RejectsAMapWithoutTheControlledSegments) {
   RetargetOptions o;
   o.calibration = "tpose";
   EXPECT_THROW(Retargeter(m, bvh, map, o), std::invalid_argument);
-}
-
-int run(const std::string& args) {
-  const int status = std::system((std::string(MANNEQUIN_BIN_DIR) + "/mannequin-retarget " + args + " > /tmp/mannequin-retarget-test.log 2>&1").c_str());
-  return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-}
-
-TEST(RetargetTool, WritesAReadableBvhAndReportsLevels) {
-  const std::string out = ::testing::TempDir() + "retarget_out.bvh";
-  ASSERT_EQ(run("data/bvh/cmu_max_131_03.bvh --mannequin configs/mannequins/female_05th.yaml --end 40 --out " + out), 0);
-  const skeleton::Bvh bvh = skeleton::readBvhFile(out);
-  EXPECT_EQ(bvh.num_frames, 40);
-  EXPECT_EQ(skeleton::bvhJointCount(bvh), 24);
-  std::ifstream log("/tmp/mannequin-retarget-test.log");
-  const std::string text((std::istreambuf_iterator<char>(log)), {});
-  EXPECT_NE(text.find("feet"), std::string::npos);
-  EXPECT_NE(text.find("hands"), std::string::npos);
-  // bad input: missing file and bad options exit 2 (command line), a bad mannequin config 1
-  EXPECT_EQ(run("no_such.bvh --out " + out), 2);
-  EXPECT_EQ(run("data/bvh/cmu_max_131_03.bvh --out " + out + " --calibration tpose"), 2);
-  EXPECT_EQ(run("data/bvh/cmu_max_131_03.bvh --out " + out + " --start 5 --end 5"), 1);
-  EXPECT_EQ(run("data/bvh/cmu_max_131_03.bvh --mannequin data/README.md --out " + out), 1);
 }
 
 }  // namespace

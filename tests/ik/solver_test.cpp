@@ -1,7 +1,9 @@
 // The IK solver: task Jacobians (finite differences), strictness, clamping loop, ball joints and
 // the free-floating root, and paper Fig. 8 on the mannequin.
 // GCC 12 reports a false -Wrestrict in std::string operator+ at -O3 (GCC bug 105329).
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wrestrict"
+#endif
 #include <gtest/gtest.h>
 
 #include <cstdio>

@@ -11,7 +11,7 @@ const std::vector<std::string>& Retargeter::controlledSegments() {
 
 Retargeter::Retargeter(const Model& model, const skeleton::Bvh& bvh, const skeleton::BvhDriveMap& map,
                        RetargetOptions options)
-    : model_(model), bvh_(bvh), driver_(model, bvh, map), options_(std::move(options)) {
+    : bvh_(bvh), driver_(model, bvh, map), options_(std::move(options)) {
   if (options_.calibration != "first" && options_.calibration != "rest")
     throw std::invalid_argument("retarget: calibration must be 'first' or 'rest', got '" + options_.calibration + "'");
   if (options_.max_iterations < 1) throw std::invalid_argument("retarget: max_iterations must be >= 1");

@@ -1,5 +1,7 @@
 // g++ 12 reports false maybe-uninitialized warnings inside Eigen's self-adjoint kernels
+#if defined(__GNUC__) && !defined(__clang__)
 #pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
 #include "mannequin/lcp/structured.hpp"
 
 #include <algorithm>

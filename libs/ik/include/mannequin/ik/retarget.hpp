@@ -60,7 +60,6 @@ class Retargeter {
  private:
   SE3 actorPose(const std::vector<SE3>& world, int s) const;
 
-  const Model& model_;
   const skeleton::Bvh& bvh_;
   skeleton::BvhDriver driver_;
   RetargetOptions options_;
