@@ -1,5 +1,6 @@
 // libFuzzer target for the C3D reader: any input either throws C3dError naming a byte inside it, or
-// yields a consistent C3d (whole frames only, finite valid samples, one label per point).
+// yields a consistent C3d (whole frames only, finite valid samples, one label per point, analog samples
+// matching the channels); its force plates then decode or throw C3dError naming a byte inside it.
 #include <algorithm>
 #include <cmath>
 #include <cstddef>
@@ -7,6 +8,7 @@
 #include <string_view>
 
 #include "mannequin/mocap/c3d.hpp"
+#include "mannequin/mocap/force_plate.hpp"
 
 namespace mc = mannequin::mocap;
 
@@ -49,5 +51,22 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     (void)p.strings();
   }
   if (c.frames_present > 0) (void)mc::resolveC3dFrame(c, -1);
+  if (c.analog_channels > 0) {
+    check(c.analog_subframes * c.analog_channels == c.analog_per_frame);
+    check(c.analog_stored.size() == static_cast<std::size_t>(c.frames_present) * static_cast<std::size_t>(c.analog_per_frame));
+    check(c.analog_labels.size() == static_cast<std::size_t>(c.analog_channels));
+    check(std::isfinite(c.analog_rate) && c.analog_rate >= 0.0);
+  } else {
+    check(c.analog_stored.empty());
+  }
+  try {
+    const mc::ForcePlates fp = mc::readForcePlates(c);
+    check(fp.wrench.size() == fp.plates.size() * static_cast<std::size_t>(fp.samples));
+    for (std::size_t p = 0; p < fp.plates.size(); ++p) {
+      for (int k = 0; k < fp.samples; k += std::max(1, fp.samples / 16)) (void)fp.reaction(static_cast<int>(p), k);
+    }
+  } catch (const mc::C3dError& e) {
+    check(e.file() == "fuzz.c3d" && e.offset() <= size);
+  }
   return 0;
 }

@@ -142,4 +142,40 @@ TEST_F(C3dTool, BadInputExitsTwoWithOneLineNamingTheFile) {
   EXPECT_NE(r.out.find("info"), std::string::npos);
 }
 
+TEST_F(C3dTool, PlatesJsonPerFrameAndPerAnalogSample) {
+  const ToolResult r = run("plates " + samplePath("pr") + " --json");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(lines(r.out), 1);
+  // two type-2 plates, one entry per frame; the CoP null while a plate is unloaded, on the plate while loaded
+  EXPECT_EQ(python(r.out,
+                   "p = d['plates']\n"
+                   "print(d['per'], d['rate'], d['count'], d['units'], len(p), [q['type'] for q in p], p[0]['channels'],\n"
+                   "      [len(q['force']) for q in p], [len(q['cop']) for q in p], [len(q['free_moment']) for q in p],\n"
+                   "      p[0]['cop'][0], any(c is not None for c in p[0]['cop']), [round(q['normal'][2], 3) for q in p])"),
+            "frame 50 450 mm 2 [2, 2] ['FX1', 'FY1', 'FZ1', 'MX1', 'MY1', 'MZ1'] [450, 450] [450, 450] [450, 450] None True "
+            "[1.0, 1.0]\n");
+  const ToolResult analog = run("plates " + samplePath("vr") + " --json --analog");
+  ASSERT_EQ(analog.exit_code, 0) << analog.err;
+  EXPECT_EQ(python(analog.out, "print(d['per'], d['rate'], d['count'], len(d['plates'][1]['force']))"),
+            "analog sample 200 1800 1800\n");
+  // the text form names the plates and their load
+  const ToolResult text = run("plates " + samplePath("sr"));
+  ASSERT_EQ(text.exit_code, 0) << text.err;
+  EXPECT_NE(text.out.find("plate 2:    type 2, channels FX2 FY2 FZ2 MX2 MY2 MZ2"), std::string::npos) << text.out;
+  EXPECT_NE(text.out.find("mean normal force while loaded"), std::string::npos) << text.out;
+  // a plate with an unknown type: exit 2, one line naming the file and the parameter
+  std::string bytes = slurp(samplePath("pr"));
+  const std::size_t at = bytes.find("TYPE");
+  ASSERT_NE(at, std::string::npos);
+  // TYPE's values: after the name, the next offset (2), the type (1), one dimension (1 + 1)
+  bytes[at + 4 + 2 + 1 + 1 + 1] = 9;
+  bytes[at + 4 + 2 + 1 + 1 + 2] = 0;
+  const std::string bad = write("bad_type.c3d", bytes);
+  const ToolResult e = run("plates " + bad);
+  EXPECT_EQ(e.exit_code, 2);
+  EXPECT_EQ(lines(e.err), 1) << e.err;
+  EXPECT_NE(e.err.find(bad + ": byte "), std::string::npos) << e.err;
+  EXPECT_NE(e.err.find("FORCE_PLATFORM:TYPE of plate 1 is 9"), std::string::npos) << e.err;
+}
+
 }  // namespace

@@ -1,5 +1,5 @@
 /// \file main.cpp
-/// \brief mannequin-c3d: summary and marker positions of a C3D motion capture.
+/// \brief mannequin-c3d: summary, marker positions and force plates of a C3D motion capture.
 ///
 /// Exit codes: 0 success, 2 bad input (unreadable or malformed C3D file, bad command line, bad or
 /// out-of-range frame); the message is one line naming the file and what is wrong.
@@ -16,6 +16,7 @@
 #include "mannequin/core/main.hpp"
 #include "mannequin/core/text.hpp"
 #include "mannequin/mocap/c3d.hpp"
+#include "mannequin/mocap/force_plate.hpp"
 
 namespace mc = mannequin::mocap;
 
@@ -76,7 +77,12 @@ int runInfo(const std::string& path, bool json) {
   if (c.truncated) {
     std::printf("TRUNCATED:  only %d whole frames present of %d declared\n", c.frames_present, c.framesDeclared());
   }
-  std::printf("analog:     %d samples per frame (not read)\n", c.analog_per_frame);
+  if (c.analog_channels > 0) {
+    std::printf("analog:     %d channels x %d samples per frame at %s Hz\n", c.analog_channels, c.analog_subframes,
+                num(c.analog_rate).c_str());
+  } else {
+    std::printf("analog:     %d samples per frame (no ANALOG:USED: not read)\n", c.analog_per_frame);
+  }
   std::printf("labels:    ");
   for (const std::string& l : c.labels) std::printf(" %s", l.c_str());
   std::printf("\n");
@@ -124,11 +130,74 @@ int runPoints(const std::string& path, const std::string& frame_list, bool json)
   return 0;
 }
 
+std::string vec(const Eigen::Vector3d& v) { return "[" + num(v.x()) + ", " + num(v.y()) + ", " + num(v.z()) + "]"; }
+
+int runPlates(const std::string& path, bool json, bool analog) {
+  const mc::C3d c = mc::readC3dFile(path);
+  const mc::ForcePlates fp = mc::readForcePlates(c);
+  const int count = analog ? fp.samples : c.frames_present;
+  const double rate = analog ? fp.rate : c.rate;
+  auto at = [&](int p, int k) { return analog ? fp.reaction(p, k) : fp.frameReaction(p, k); };
+  const std::string length = c.units.empty() ? "file units" : c.units;
+  if (!json) {
+    std::printf("file:       %s\n", path.c_str());
+    std::printf("plates:     %zu; reactions on the subject in the lab frame, force in N, CoP in %s, free moment in N %s\n",
+                fp.plates.size(), length.c_str(), length.c_str());
+    for (std::size_t p = 0; p < fp.plates.size(); ++p) {
+      const mc::ForcePlate& plate = fp.plates[p];
+      std::printf("plate %zu:    type %d, channels", p + 1, plate.type);
+      for (const int ch : plate.channels) std::printf(" %s", c.analog_labels[static_cast<std::size_t>(ch)].c_str());
+      std::printf("\n  centre %s, normal %s, baseline frames %d..%d\n", vec(plate.centre).c_str(), vec(plate.normal()).c_str(),
+                  plate.zero_first, plate.zero_last);
+      double peak = 0.0, sum = 0.0;
+      int loaded = 0;
+      for (int k = 0; k < count; ++k) {
+        const mc::PlateReaction r = at(static_cast<int>(p), k);
+        peak = std::max(peak, r.normal_force);
+        if (r.normal_force >= fp.threshold) {
+          ++loaded;
+          sum += r.normal_force;
+        }
+      }
+      std::printf("  loaded (>= %.0f N) %d of %d %s (%.3f s), mean normal force while loaded %.1f N, peak %.1f N\n",
+                  fp.threshold, loaded, count, analog ? "samples" : "frames", rate > 0 ? loaded / rate : 0.0,
+                  loaded > 0 ? sum / loaded : 0.0, peak);
+    }
+    return 0;
+  }
+  std::string out = "{\"file\": " + jsonString(path) + ", \"per\": " + jsonString(analog ? "analog sample" : "frame") +
+                    ", \"rate\": " + num(rate) + ", \"count\": " + std::to_string(count) + ", \"units\": " +
+                    jsonString(c.units) + ", \"threshold_n\": " + num(fp.threshold) + ", \"plates\": [";
+  for (std::size_t p = 0; p < fp.plates.size(); ++p) {
+    const mc::ForcePlate& plate = fp.plates[p];
+    out += (p ? ", " : "") + std::string("{\"type\": ") + std::to_string(plate.type) + ", \"channels\": [";
+    for (std::size_t q = 0; q < plate.channels.size(); ++q) {
+      out += (q ? ", " : "") + jsonString(c.analog_labels[static_cast<std::size_t>(plate.channels[q])]);
+    }
+    out += "], \"corners\": [";
+    for (std::size_t q = 0; q < 4; ++q) out += (q ? ", " : "") + vec(plate.corners[q]);
+    out += "], \"origin\": " + vec(plate.origin) + ", \"centre\": " + vec(plate.centre) + ", \"normal\": " +
+           vec(plate.normal()) + ", \"force\": [";
+    std::string cop = "], \"cop\": [", moment = "], \"free_moment\": [";
+    for (int k = 0; k < count; ++k) {
+      const mc::PlateReaction r = at(static_cast<int>(p), k);
+      const char* sep = k ? ", " : "";
+      out += sep + vec(r.force);
+      cop += sep + (r.cop.allFinite() ? vec(r.cop) : std::string("null"));
+      moment += sep + num(r.free_moment);
+    }
+    out += cop + moment + "]}";
+  }
+  out += "]}\n";
+  std::fputs(out.c_str(), stdout);
+  return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"mannequin-c3d: inspect a C3D motion capture (header, parameters, 3D marker positions).\n"
-               "Reads Intel, DEC/VAX and SGI/MIPS files, int16 and float storage; analog samples are skipped.\n"
+  CLI::App app{"mannequin-c3d: inspect a C3D motion capture (header, parameters, 3D marker positions, force plates).\n"
+               "Reads Intel, DEC/VAX and SGI/MIPS files, int16 and float storage, and their analog channels.\n"
                "Exit codes: 0 ok, 2 bad input: unreadable or malformed C3D (message 'FILE: byte OFFSET: what'), "
                "bad command line, frame out of range.",
                "mannequin-c3d"};
@@ -161,6 +230,22 @@ int main(int argc, char** argv) {
       ->required();
   points->add_flag("--json", points_json, "machine-readable output");
 
+  std::string plates_file;
+  bool plates_json = false;
+  bool plates_analog = false;
+  CLI::App* plates = app.add_subcommand(
+      "plates",
+      "Force plates (FORCE_PLATFORM types 1-4): the ground reaction on the subject in the lab frame, per 3D frame "
+      "(the plate's wrench averaged over the frame's analog samples) or per analog sample (--analog). Text: each "
+      "plate's type, channels, centre, normal, and its loaded time, mean and peak normal force. --json prints "
+      "{\"file\", \"per\": \"frame\"|\"analog sample\", \"rate\": Hz, \"count\": N, \"units\": POINT:UNITS, "
+      "\"threshold_n\": 20, \"plates\": [{\"type\", \"channels\": [ANALOG:LABELS], \"corners\", \"origin\", "
+      "\"centre\", \"normal\", \"force\": [[fx, fy, fz] N, ...], \"cop\": [[x, y, z] or null below the threshold, ...], "
+      "\"free_moment\": [N x length unit, ...]}]}.");
+  plates->add_option("FILE", plates_file, "C3D file")->required();
+  plates->add_flag("--json", plates_json, "machine-readable output");
+  plates->add_flag("--analog", plates_analog, "one value per analog sample instead of per 3D frame");
+
   // "--frames -1" would otherwise read -1 as an option: glue a negative list to its option
   std::vector<std::string> args(argv + 1, argv + argc);
   for (std::size_t i = 0; i + 1 < args.size(); ++i) {
@@ -173,6 +258,7 @@ int main(int argc, char** argv) {
   return mannequin::core::runMain(app, args, [&] {
     try {
       if (info->parsed()) return runInfo(info_file, info_json);
+      if (plates->parsed()) return runPlates(plates_file, plates_json, plates_analog);
       return runPoints(points_file, points_frames, points_json);
     } catch (const UsageError& e) {
       std::cerr << "mannequin-c3d: " << e.what() << "\n";

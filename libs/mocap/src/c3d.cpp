@@ -345,6 +345,73 @@ C3d parseC3d(std::string_view bytes, const std::string& file) {
     if (!s.empty()) c.units = s.front();
   }
 
+  // --- ANALOG parameters: channels, subframes, rate, labels, units, scaling (C3D user guide, ANALOG group)
+  bool analog_unsigned = false;
+  if (c.analog_per_frame > 0) {
+    if (const C3dParameter* used = c.find("ANALOG", "USED"); used != nullptr && !used->numbers.empty()) {
+      const int n = unsignedCount(used->numbers.front());
+      if (n <= 0 || c.analog_per_frame % n != 0) {
+        r.fail(used->offset, "ANALOG:USED = " + std::to_string(used->numbers.front()) + " does not divide the " +
+                                 std::to_string(c.analog_per_frame) + " analog samples per frame of the header (byte 4)");
+      }
+      c.analog_channels = n;
+      c.analog_subframes = c.analog_per_frame / n;
+    }
+  }
+  if (c.analog_channels > 0) {
+    const auto channels = static_cast<std::size_t>(c.analog_channels);
+    c.analog_rate = c.rate * c.analog_subframes;
+    if (const C3dParameter* p = c.find("ANALOG", "RATE"); p != nullptr && !p->numbers.empty()) {
+      const double v = p->numbers.front();
+      if (!std::isfinite(v) || v <= 0.0) r.fail(p->offset, "ANALOG:RATE is not a positive rate (" + std::to_string(v) + ")");
+      c.analog_rate = v;
+    }
+    for (int k = 1; c.analog_labels.size() < channels; ++k) {
+      const C3dParameter* p = c.find("ANALOG", k == 1 ? std::string("LABELS") : "LABELS" + std::to_string(k));
+      if (p == nullptr) break;
+      for (const std::string& l : p->strings()) {
+        if (c.analog_labels.size() < channels) c.analog_labels.push_back(l);
+      }
+    }
+    for (std::size_t k = c.analog_labels.size(); k < channels; ++k) c.analog_labels.push_back("A" + std::to_string(k + 1));
+    if (const C3dParameter* p = c.find("ANALOG", "UNITS")) c.analog_units = p->strings();
+    c.analog_units.resize(channels);
+    // per-channel numbers: SCALE (default 1) and OFFSET (default 0), one per channel at least, finite
+    auto perChannel = [&](const char* name, double fallback) {
+      std::vector<double> out(channels, fallback);
+      const C3dParameter* p = c.find("ANALOG", name);
+      if (p == nullptr) return out;
+      if (p->numbers.size() < channels) {
+        r.fail(p->offset, std::string("ANALOG:") + name + " has " + std::to_string(p->numbers.size()) +
+                              " values for " + std::to_string(channels) + " channels (ANALOG:USED)");
+      }
+      for (std::size_t k = 0; k < channels; ++k) {
+        if (!std::isfinite(p->numbers[k])) {
+          r.fail(p->offset, std::string("ANALOG:") + name + " of channel " + std::to_string(k + 1) + " is not finite");
+        }
+        out[k] = p->numbers[k];
+      }
+      return out;
+    };
+    if (const C3dParameter* p = c.find("ANALOG", "FORMAT")) {
+      const auto f = p->strings();
+      analog_unsigned = !f.empty() && upper(f.front()) == "UNSIGNED";
+    }
+    c.analog_scale = perChannel("SCALE", 1.0);
+    c.analog_offset = perChannel("OFFSET", 0.0);
+    // unsigned samples have unsigned offsets (the user guide's notes for programmers): 32768 is stored as −32768
+    if (analog_unsigned) {
+      for (double& o : c.analog_offset) {
+        if (o < 0.0) o += 65536.0;
+      }
+    }
+    if (const C3dParameter* p = c.find("ANALOG", "GEN_SCALE"); p != nullptr && !p->numbers.empty()) {
+      const double v = p->numbers.front();
+      if (!std::isfinite(v) || v == 0.0) r.fail(p->offset, "ANALOG:GEN_SCALE is not a finite non-zero factor (" + std::to_string(v) + ")");
+      c.analog_gen_scale = v;
+    }
+  }
+
   // --- the frames: (4 × points + analog) words each, int16 or float; whole frames only
   const std::size_t word = c.storage == C3dStorage::kFloat ? 4 : 2;
   const std::size_t frame_bytes = (4 * static_cast<std::size_t>(c.points) + static_cast<std::size_t>(c.analog_per_frame)) * word;
@@ -392,7 +459,37 @@ C3d parseC3d(std::string_view bytes, const std::string& file) {
       }
     }
   }
+  // the analog words follow the points in each frame (read only when ANALOG:USED says how to split them)
+  if (c.analog_channels > 0) {
+    const auto per_frame = static_cast<std::size_t>(c.analog_per_frame);
+    c.analog_stored.resize(static_cast<std::size_t>(c.frames_present) * per_frame);
+    for (int f = 0; f < c.frames_present; ++f) {
+      const std::size_t at = data_offset + static_cast<std::size_t>(f) * frame_bytes + 4 * static_cast<std::size_t>(c.points) * word;
+      float* out = c.analog_stored.data() + static_cast<std::size_t>(f) * per_frame;
+      for (std::size_t k = 0; k < per_frame; ++k) {
+        const std::size_t o = at + k * word;
+        if (c.storage == C3dStorage::kFloat) {
+          out[k] = r.f32(o);
+        } else {
+          out[k] = analog_unsigned ? static_cast<float>(r.u16(o)) : static_cast<float>(r.s16(o));
+        }
+      }
+    }
+  }
   return c;
+}
+
+double C3d::analog(int sample, int channel) const {
+  const std::size_t k = static_cast<std::size_t>(sample) * static_cast<std::size_t>(analog_channels) + static_cast<std::size_t>(channel);
+  const auto ch = static_cast<std::size_t>(channel);
+  return (static_cast<double>(analog_stored[k]) - analog_offset[ch]) * analog_scale[ch] * analog_gen_scale;
+}
+
+int C3d::analogIndex(std::string_view label) const {
+  for (std::size_t k = 0; k < analog_labels.size(); ++k) {
+    if (analog_labels[k] == label) return static_cast<int>(k);
+  }
+  return -1;
 }
 
 C3d readC3dFile(const std::string& path) {

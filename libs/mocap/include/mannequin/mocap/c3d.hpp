@@ -4,7 +4,8 @@
 /// parameter section (groups and parameters, looked up by name, case-insensitive) and the 3D point
 /// samples of every frame, for the three processor formats of the spec (Intel 84, DEC/VAX 85 with VAX
 /// F floats converted to IEEE, SGI/MIPS 86 big endian) and both storages (int16 scaled by POINT:SCALE,
-/// float when POINT:SCALE is negative). Analog samples are skipped, not read.
+/// float when POINT:SCALE is negative), and the analog samples (ANALOG group: channels, subframes, SCALE,
+/// OFFSET, GEN_SCALE, FORMAT) that force plates (force_plate.hpp) are decoded from.
 ///
 /// Untrusted input: every size is checked against the bytes present before anything is allocated
 /// from it; a malformed file throws C3dError naming the file, the byte offset and what is wrong. A
@@ -69,7 +70,7 @@ struct C3d {
   C3dStorage storage = C3dStorage::kInt16;
 
   int points = 0;            ///< 3D points per frame (header word 2 = POINT:USED)
-  int analog_per_frame = 0;  ///< analog samples per 3D frame, all channels (header word 3; skipped)
+  int analog_per_frame = 0;  ///< analog samples per 3D frame, all channels (header word 3)
   int first_frame = 1;       ///< header word 4 (1-based, as the file numbers frames)
   int last_frame = 0;        ///< header word 5
   double rate = 0.0;         ///< frames per second (POINT:RATE, else the header)
@@ -89,6 +90,29 @@ struct C3d {
   std::vector<float> xyz;
   /// frames_present × points residuals in the file's units; negative where the sample is invalid.
   std::vector<float> residual;
+
+  /// Analog channels (ANALOG:USED; 0 when the file has no analog data) and samples of each channel per
+  /// 3D frame (analog_per_frame / analog_channels).
+  int analog_channels = 0;
+  int analog_subframes = 0;
+  double analog_rate = 0.0;  ///< samples per second of one channel (ANALOG:RATE, else rate × subframes)
+  /// One per channel: ANALOG:LABELS trimmed ("A<n>", 1-based, where the file has none), ANALOG:UNITS ("").
+  std::vector<std::string> analog_labels;
+  std::vector<std::string> analog_units;
+  /// Per channel: value = (stored − analog_offset) × analog_scale × analog_gen_scale (C3D user guide).
+  std::vector<double> analog_scale;
+  std::vector<double> analog_offset;
+  double analog_gen_scale = 1.0;
+  /// Stored analog words, frames_present × analog_subframes × analog_channels, in file order (subframe
+  /// major, channel minor): int16 as signed, or unsigned with ANALOG:FORMAT "UNSIGNED"; floats as read.
+  std::vector<float> analog_stored;
+
+  /// Analog samples per channel present (frames_present × analog_subframes).
+  int analogSamples() const { return frames_present * analog_subframes; }
+  /// The scaled value of `channel` (0-based) at analog sample `sample` (0-based, < analogSamples()).
+  double analog(int sample, int channel) const;
+  /// Index of the analog channel labelled `label` (case-sensitive, trimmed), or -1.
+  int analogIndex(std::string_view label) const;
 
   /// The parameter GROUP:NAME (case-insensitive), or nullptr.
   const C3dParameter* find(std::string_view group, std::string_view name) const;
