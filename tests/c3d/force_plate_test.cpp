@@ -333,7 +333,9 @@ void expectPlateError(const std::string& bytes, const char* parameter, const std
     ADD_FAILURE() << "no error, expected '" << text << "'";
   } catch (const mc::C3dError& e) {
     EXPECT_EQ(e.file(), "plates.c3d");
-    if (p != nullptr) EXPECT_EQ(e.offset(), p->offset) << e.what();
+    if (p != nullptr) {
+      EXPECT_EQ(e.offset(), p->offset) << e.what();
+    }
     EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
   }
 }
