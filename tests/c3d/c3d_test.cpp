@@ -18,13 +18,7 @@ using c3dtest::WriteSpec;
 
 namespace {
 using c3dtest::samplePath;
-
-std::string readBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
+using c3dtest::fileBytes;
 
 // what the reader must say about `bytes`: a C3dError at `offset` whose message contains `text`
 void expectError(const std::string& bytes, std::size_t offset, const std::string& text) {
@@ -44,7 +38,7 @@ class Samples : public ::testing::Test {
   static void SetUpTestSuite() {
     for (const char* k : {"pr", "sr", "vr"}) {
       const std::string path = samplePath(k);
-      ASSERT_FALSE(readBytes(path).empty()) << "missing sample " << path;
+      ASSERT_FALSE(fileBytes(path).empty()) << "missing sample " << path;
     }
   }
 };
@@ -196,7 +190,7 @@ TEST(C3dWriter, FloatStorageInThreeFormatsIsExact) {
 // -- truncated files -----------------------------------------------------------------------------
 
 TEST_F(Samples, TruncatedFileGivesTheWholeFramesBeforeTheCut) {
-  const std::string bytes = readBytes(samplePath("pr"));
+  const std::string bytes = fileBytes(samplePath("pr"));
   const mc::C3d full = mc::parseC3d(bytes, "full.c3d");
   const std::size_t data = 10 * 512;
   const std::size_t frame = (26 * 4 + 64) * 4;  // 672 bytes
@@ -225,7 +219,7 @@ TEST_F(Samples, TruncatedFileGivesTheWholeFramesBeforeTheCut) {
 // -- malformed inputs -----------------------------------------------------------------------------
 
 TEST_F(Samples, MalformedInputsNameTheOffset) {
-  const std::string good = readBytes(samplePath("pr"));
+  const std::string good = fileBytes(samplePath("pr"));
   // a cut header
   expectError(good.substr(0, 100), 0, "the 512-byte header runs past the end of the file");
   expectError("", 0, "header");

@@ -10,8 +10,6 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
-#include <fstream>
-#include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -23,13 +21,6 @@
 namespace mc = mannequin::mocap;
 
 namespace {
-
-std::string plateFileBytes(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  std::ostringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 float littleEndianFloat(const std::string& b, std::size_t o) {
   std::uint32_t v = 0;
@@ -78,7 +69,7 @@ HandSample handSample(const std::string& bytes, int s) {
 
 TEST(ForcePlates, OneSampleOfTheRealFileDecodedByHandFromItsBytes) {
   const std::string path = c3dtest::samplePath("pr");
-  const std::string bytes = plateFileBytes(path);
+  const std::string bytes = c3dtest::fileBytes(path);
   ASSERT_GT(bytes.size(), kDataStart + 450 * kFrameBytes - 1) << path;
   const mc::C3d c = mc::readC3dFile(path);
   const mc::ForcePlates fp = mc::readForcePlates(c);
@@ -341,7 +332,7 @@ void expectPlateError(const std::string& bytes, const char* parameter, const std
 }
 
 TEST(ForcePlates, BadParametersAreNamedWithTheirOffset) {
-  const std::string good = plateFileBytes(c3dtest::samplePath("pr"));
+  const std::string good = c3dtest::fileBytes(c3dtest::samplePath("pr"));
   const mc::C3d c = mc::parseC3d(good, "plates.c3d");
   const mc::C3dParameter& type = *c.find("FORCE_PLATFORM", "TYPE");
   const mc::C3dParameter& channel = *c.find("FORCE_PLATFORM", "CHANNEL");
