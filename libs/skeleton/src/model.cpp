@@ -216,6 +216,10 @@ Data::Data(const Model& model)
       Jcom(Matrix3X::Zero(3, model.nv)),
       segment_com(model.segments.size(), Vector3::Zero()),
       subtree_mass(model.joints.size(), 0.0),
-      subtree_moment(model.joints.size(), Vector3::Zero()) {}
+      subtree_moment(model.joints.size(), Vector3::Zero()),
+      joint_twist(model.joints.size(), Vector6::Zero()),
+      joint_accel(model.joints.size(), Vector6::Zero()),
+      joint_wrench(model.joints.size(), Vector6::Zero()),
+      tau(VectorX::Zero(model.nv)) {}
 
 }  // namespace mannequin::skeleton

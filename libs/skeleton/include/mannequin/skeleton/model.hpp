@@ -179,6 +179,11 @@ struct Data {
   // scratch for the CoM Jacobian (subtree mass and first moment)
   std::vector<double> subtree_mass;     ///< (njoints)
   std::vector<Vector3> subtree_moment;  ///< (njoints) Σ m c over the subtree, world
+  // inverse dynamics (dynamics.hpp): spatial quantities per joint, world frame, reduced at the origin
+  std::vector<Vector6> joint_twist;   ///< (njoints) twist (ω, v) of each joint's body
+  std::vector<Vector6> joint_accel;   ///< (njoints) spatial acceleration, gravity's −g included
+  std::vector<Vector6> joint_wrench;  ///< (njoints) wrench (n, f) the parent applies through the joint
+  VectorX tau;                        ///< (nv) joint torques / generalized forces, dual to v
 };
 
 }  // namespace mannequin::skeleton
