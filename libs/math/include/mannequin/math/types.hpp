@@ -3,6 +3,8 @@
 /// \brief Eigen aliases shared by every mannequin library (scalar: double).
 #include <Eigen/Dense>
 
+#include "mannequin/math/decompositions.hpp"
+
 namespace mannequin::math {
 
 using Vector3 = Eigen::Vector3d;
