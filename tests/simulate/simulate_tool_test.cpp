@@ -150,6 +150,16 @@ TEST_F(SimulateTool, TheLeaningWorkerHoldsTheWholeMarginOnlyWithTheHandOnTheWall
       "assert d['nan_steps'] == 0 and d['max_penetration_m'] < 0.01, d\n"
       "assert d['min_force_margin_n'] > 0, d\nassert abs(d['sim_time_s'] - 8.0) < 0.02, d\nprint('ok')");
   EXPECT_EQ(status, 0) << out << a.out;
+  // the whole-body kinetics of the lean (docs/kinetics.md): it starts and ends at rest, so the floor and the
+  // wall carry the weight on average (momentum balance, within the 3 % the method's filter and residual
+  // allow); the 50th-percentile male weighs 78.5 kg
+  const auto [k_status, k_out] = pythonOn(
+      a.out,
+      "k = d['kinetics']\nassert len(k) == 1 and k[0]['mannequin'] == 'operator', k\n"
+      "k = k[0]\nassert abs(k['weight_n'] - 78.5 * 9.81) < 0.5, k\nassert k['samples'] >= 400, k\n"
+      "assert abs(k['grf_mean_over_weight'] - 1.0) < 0.03, k\n"
+      "assert k['residual_force_mean_n'] < 0.1 * k['weight_n'], k\nprint('ok')");
+  EXPECT_EQ(k_status, 0) << k_out << a.out;
   // a bad balance controller setting: exit 2 naming the file, line and field
   const fs::path cfg = temp("bad_balance.yaml");
   std::ofstream(cfg) << "name: sim\nstep: 0.001\nphysics:\n  enabled: true\n  scene: configs/scenes/bay.yaml\n"

@@ -75,7 +75,7 @@ std::string runJson(const Run& r) {
       "\"contact_force_n\": {{\"mean\": {}, \"max\": {}, \"p95\": {}}}, "
       "\"rula\": {}, \"rula_time_at_action_level_s\": [{}], \"reba\": {}, \"reba_time_at_action_level_s\": [{}], "
       "\"rula_time_at_or_above_action_level_s\": [{}], \"reba_time_at_or_above_action_level_s\": [{}], "
-      "\"hand_force_n\": {{\"left\": {}, \"right\": {}}}, "
+      "\"hand_force_n\": {{\"left\": {}, \"right\": {}}}, \"kinetics\": {}, "
       "\"series\": {{\"time_s\": {}, \"rula\": {}, \"reba\": {}, \"balance_distance_m\": {}, \"contacts\": {}, \"contact_force_n\": {}, "
       "\"penetration_m\": {}, \"tracking_error_m\": {}, \"hand_force_l_n\": {}, \"hand_force_r_n\": {}}}, \"snapshots\": {}, \"reach\": {}, "
       "\"time_per_step_us\": {{\"mean\": {}, \"max\": {}}}}}",
@@ -84,6 +84,7 @@ std::string runJson(const Run& r) {
       num(mean(r.force)), num(maxOf(r.force)), num(percentile(r.force, 0.95)),
       scoreJson(r.rula_all, r.rula_hist.data(), 7, maxOf(r.rula), mean(r.rula)), levels_rula,
       scoreJson(r.reba_all, r.reba_hist.data(), 15, maxOf(r.reba), mean(r.reba)), levels_reba, above_rula, above_reba, hand(0), hand(1),
+      s.kinetics.empty() ? std::string("null") : simservice::kineticsJson(s.kinetics.front()),
       series(r.t), series(r.rula),
       series(r.reba), series(r.balance), series(r.contacts), series(r.force), series(r.penetration), series(r.tracking), series(r.hand_l), series(r.hand_r), shots, reach,
       num(r.step_n ? 1e6 * r.step_wall_sum / static_cast<double>(r.step_n) : kNaN),

@@ -36,6 +36,12 @@ std::string ergonomicsJson(const Summary& s) {
   return out + "]";
 }
 
+std::string kineticsJson(const Summary& s) {
+  std::string out = "[";
+  for (std::size_t i = 0; i < s.kinetics.size(); ++i) out += (i ? ", " : "") + simservice::kineticsJson(s.kinetics[i]);
+  return out + "]";
+}
+
 std::string scenarioJson(const Summary& s) {
   if (s.scenario.empty()) return "null";
   std::string timeline;
@@ -53,11 +59,12 @@ void printJson(const Summary& s) {
       "{%s, \"physics\": %s, \"worst_joint_limit_excess_rad\": %s, \"mean_force_margin_n\": %s, "
       "\"balance_controller\": {\"enabled\": %s, \"solves\": %lld, \"failures\": %lld, \"driving_fraction\": %s, "
       "\"full_margin_fraction\": %s}, "
-      "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld, \"ergonomics\": %s, \"scenario\": %s}\n",
+      "\"mean_hand_error_m\": %s, \"mean_foot_error_m\": %s, \"worlds\": %lld, \"ergonomics\": %s, \"kinetics\": %s, "
+      "\"scenario\": %s}\n",
       simservice::summaryJsonMembers(s).c_str(), s.physics ? "true" : "false", num(s.worst_joint_limit_excess_rad).c_str(),
       num(s.meanForceMargin()).c_str(), s.balance_controller ? "true" : "false", s.balance_solves, s.balance_failures,
       num(s.balanceDrivingFraction()).c_str(), num(s.balanceFullMarginFraction()).c_str(), num(s.meanHandError()).c_str(),
-      num(s.meanFootError()).c_str(), s.worlds, ergonomicsJson(s).c_str(), scenarioJson(s).c_str());
+      num(s.meanFootError()).c_str(), s.worlds, ergonomicsJson(s).c_str(), kineticsJson(s).c_str(), scenarioJson(s).c_str());
 }
 
 void printHuman(const Summary& s, const std::string& out) {
@@ -82,6 +89,14 @@ void printHuman(const Summary& s, const std::string& out) {
                   "%lld solves, %lld failed updates\n",
                   100.0 * s.balanceDrivingFraction(), 100.0 * s.balanceFullMarginFraction(), s.balance_solves, s.balance_failures);
     std::printf("limits      worst excess %.4f rad\n", s.worst_joint_limit_excess_rad);
+    for (const sim::MannequinKinetics& mk : s.kinetics) {
+      const kinetics::KineticsSummary& k = mk.summary;
+      if (k.frames == 0) continue;
+      std::printf("kinetics    %s: ground reaction %.3f x weight (%.0f N) on average, peak %.0f N; residual force mean "
+                  "%.1f N, peak %.1f N; residual moment peak %.1f N m\n",
+                  mk.mannequin.c_str(), k.grf_mean_over_weight, k.weight_n, k.peak_external_force_n, k.residual_force_mean_n,
+                  k.residual_force_peak_n, k.residual_moment_peak_nm);
+    }
   } else {
     std::printf("physics     off (sim config `physics: {enabled: true, scene: ...}` or --scene turns it on)\n");
   }

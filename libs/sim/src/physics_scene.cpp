@@ -334,6 +334,34 @@ std::array<math::Vector3, 2> World::handForces(int m) const {
   return out;
 }
 
+void World::kineticsInputs(int m, std::vector<kinetics::ContactPoint>& contacts, std::vector<kinetics::Load>& loads) const {
+  contacts.clear();
+  loads.clear();
+  if (!physics_ || m < 0 || m >= numMannequins()) return;
+  const Physics& P = *physics_;
+  const skeleton::Data& d = data(m);
+  const auto mannequinOf = [&](int body) {
+    return body >= 0 && static_cast<std::size_t>(body) < P.body_mannequin.size() ? P.body_mannequin[static_cast<std::size_t>(body)] : -1;
+  };
+  for (const ContactReport& c : contacts_) {  // n from a to b: the other body pushes a along −n, b along +n
+    if (!(c.normal_force > 0 || c.distance <= 0)) continue;
+    const bool on_a = mannequinOf(c.body_a) == m, on_b = mannequinOf(c.body_b) == m;
+    if (on_a == on_b) continue;  // not on m, or between two of its own segments (internal)
+    const int body = on_a ? c.body_a : c.body_b;
+    kinetics::ContactPoint p;
+    p.point = c.point;
+    p.normal = on_a ? math::Vector3(-c.normal) : c.normal;
+    p.mu = P.contacts ? P.contacts->friction(c.body_a, c.body_b) : 0.0;
+    p.joint = P.body_joint[static_cast<std::size_t>(body)];
+    contacts.push_back(p);
+  }
+  for (std::size_t h = 0; h < P.grasp_records.size(); ++h) {
+    const Physics::GraspRecord& g = P.grasp_records[h];
+    if (g.object < 0 || g.mannequin != m || g.joint < 0) continue;
+    loads.push_back(kinetics::Load{g.joint, d.oMi[static_cast<std::size_t>(g.joint)].p, -P.grasps->force(static_cast<int>(h))});
+  }
+}
+
 void World::attachGuide(int i, const control::MechanismSpec& spec) {
   if (!physics_ || !physics_->guides) throw std::invalid_argument("sim: a guide needs physics and a scene with objects");
   physics_->guides->attach(i, spec);

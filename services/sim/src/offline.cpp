@@ -15,6 +15,7 @@
 
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/core/paths.hpp"
+#include "mannequin/core/text.hpp"
 #include "mannequin/mocap/bvh_source.hpp"
 #include "mannequin/mocap/c3d_source.hpp"
 #include "mannequin/proto/schema.hpp"
@@ -184,6 +185,18 @@ std::string summaryJsonMembers(const OfflineSummary& s) {
       s.frames, s.steps, num(s.sim_time_s), num(s.wall_s), num(s.realtimeFactor()), s.nan_steps, s.lcp_failures,
       num(s.max_penetration_m), s.max_contacts, num(s.meanContacts()), num(s.footContactFraction()),
       num(s.min_balance_distance_m), num(s.min_force_margin_n));
+}
+
+std::string kineticsJson(const sim::MannequinKinetics& mk) {
+  const auto num = [](double v) { return std::isfinite(v) ? fmt::format("{:.17g}", v) : std::string("null"); };
+  const kinetics::KineticsSummary& k = mk.summary;
+  const bool any = k.frames > 0;
+  return fmt::format(
+      "{{\"mannequin\": {}, \"samples\": {}, \"weight_n\": {}, \"grf_mean_over_weight\": {}, \"residual_force_mean_n\": {}, "
+      "\"residual_force_peak_n\": {}, \"residual_moment_peak_nm\": {}, \"peak_external_force_n\": {}}}",
+      core::jsonString(mk.mannequin), k.frames, num(k.weight_n), any ? num(k.grf_mean_over_weight) : "null",
+      any ? num(k.residual_force_mean_n) : "null", any ? num(k.residual_force_peak_n) : "null",
+      any ? num(k.residual_moment_peak_nm) : "null", any ? num(k.peak_external_force_n) : "null");
 }
 
 OfflineRun::OfflineRun(const OfflineOptions& options) : options_(options) {
@@ -387,6 +400,7 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
       }
     }
   };
+  sim::KineticsRecorder kinetics(world);
   const auto publish = [&] {
     if (!world_rate.tick()) return;
     sampleErgonomics();
@@ -421,6 +435,7 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
                    [&](bool ok) {
                      if (on_step) on_step(world, wall() - step_started);
                      s.add(world, ok);
+                     kinetics.sample(world);
                      scenarioAfterStep();
                      publish();
                      progress.update(world.time(), wall());
@@ -473,6 +488,9 @@ OfflineSummary OfflineRun::run(const SampleHook& on_sample, const StepHook& on_s
     s.scenario_unapplied_actions = world.scenarioUnappliedActions();
   }
   if (const constraints::ConstraintSolver* cs = world.constraintSolver()) s.lcp_failures = cs->failures();
+  // sampled every step, solved at the world rate
+  if (world.physics())
+    s.kinetics = kinetics.solve(world, config.world.step, std::max(1, static_cast<int>(std::lround(1.0 / (config.world_rate * config.world.step)))));
   if (writer) writer->close();
   return s;
 }

@@ -32,6 +32,7 @@
 #include <vector>
 
 #include "mannequin/collision/world.hpp"
+#include "mannequin/kinetics/kinetics.hpp"
 #include "mannequin/sim/checkpoint.hpp"
 #include "mannequin/sim/config.hpp"
 #include "mannequin/sim/diagnostics.hpp"
@@ -169,6 +170,11 @@ class World {
   /// plus the contacts on that segment, each as its normal force along the contact normal (friction,
   /// reported as a magnitude only, is left out). Zero with physics off or without such a segment.
   std::array<math::Vector3, 2> handForces(int m) const;
+  /// The inputs of mannequin m's whole-body kinetics (libs/kinetics) at the last step: `contacts`, each
+  /// touching contact on one of its segments (λ > 0 or penetrating) as a point with the normal the other
+  /// body pushes it along, the pair's μ and the segment's joint; `loads`, the pull of each object it holds
+  /// (−grasp force) at the origin of the grasping joint. Both cleared first; empty with physics off.
+  void kineticsInputs(int m, std::vector<kinetics::ContactPoint>& contacts, std::vector<kinetics::Load>& loads) const;
   /// Guides object i on a virtual mechanism (object_guides.hpp: rows of the LCP on the object alone,
   /// thesis 4.3.1: a tray kept level, a part kept on an axis), replacing a guide it had.
   /// \throws std::invalid_argument on physics off, an unknown object, a hinged object or a spec

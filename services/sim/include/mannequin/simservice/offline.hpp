@@ -17,6 +17,7 @@
 
 #include "mannequin/ergonomics/ergonomics.hpp"
 #include "mannequin/mocap/source.hpp"
+#include "mannequin/sim/kinetics_recorder.hpp"
 #include "mannequin/sim/run_totals.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/simservice/config.hpp"
@@ -57,6 +58,9 @@ struct OfflineSummary : sim::RunTotals {
   long long balance_solves = 0, balance_failures = 0;
   bool physics = false;
   std::vector<ErgonomicsSummary> ergonomics;
+  /// Per mannequin, the whole-body kinetics of the simulated motion sampled at the world rate (physics on;
+  /// sim::KineticsRecorder): the ground reaction it needs, how the contacts carry it, the residual.
+  std::vector<sim::MannequinKinetics> kinetics;
   /// The scenario (sim config `scenario`, --scenario): "" without one; the states entered with their sim
   /// time (the initial state at the first step the engine ran), the triggers sent, the actions the World
   /// does not apply yet (World::scenarioUnappliedActions).
@@ -78,6 +82,11 @@ struct OfflineSummary : sim::RunTotals {
 /// "foot_contact_fraction", "min_balance_distance_m", "min_force_margin_n". Numbers with 17 significant
 /// digits (the same double prints the same text), null when not finite.
 std::string summaryJsonMembers(const OfflineSummary& s);
+
+/// One mannequin's kinetics as a JSON object: "mannequin", "samples", "weight_n", "grf_mean_over_weight",
+/// "residual_force_mean_n", "residual_force_peak_n", "residual_moment_peak_nm", "peak_external_force_n"
+/// (docs/kinetics.md); the ratios null without samples.
+std::string kineticsJson(const sim::MannequinKinetics& k);
 
 /// A bad input file (config, mannequin, scene, capture, a non-finite sample): the message names the
 /// FILE (and line or frame). Tools exit 2 on it.
