@@ -48,6 +48,14 @@ Vector6 spatialMomentum(const Model& m, Data& d, const VectorX& q, const VectorX
   return h;
 }
 
+// The states a time step dt before and after (q0, v0) on the path of constant acceleration a0 (explicit
+// Lie–Euler both ways), for central differences along it.
+struct StepsAround {
+  VectorX qm, vm, qp, vp;
+  StepsAround(const Model& m, const VectorX& q0, const VectorX& v0, const VectorX& a0, double dt)
+      : qm(integrate(m, q0, v0 - a0 * dt, -dt)), vm(v0 - a0 * dt), qp(integrate(m, q0, v0, dt)), vp(v0 + a0 * dt) {}
+};
+
 }  // namespace
 
 TEST(Rnea, PendulumHoldsItsWeightAndAcceleratesItsInertia) {
@@ -150,10 +158,8 @@ TEST(Rnea, RandomTreeRootWrenchIsTheRateOfMomentumMinusTheWeight) {
     const VectorX v0 = test_models::randomConfiguration(m, seed + 40, 1.5);
     const VectorX a0 = test_models::randomConfiguration(m, seed + 50, 3.0);
     const double dt = 1e-6;
-    // (q, v) a step before and after (q0, v0): explicit Lie–Euler both ways
-    const VectorX qm = integrate(m, q0, v0 - a0 * dt, -dt);
-    const VectorX qp = integrate(m, q0, v0, dt);
-    const Vector6 hdot = (spatialMomentum(m, d, qp, v0 + a0 * dt) - spatialMomentum(m, d, qm, v0 - a0 * dt)) / (2 * dt);
+    const StepsAround x(m, q0, v0, a0, dt);
+    const Vector6 hdot = (spatialMomentum(m, d, x.qp, x.vp) - spatialMomentum(m, d, x.qm, x.vm)) / (2 * dt);
     rnea(m, d, q0, v0, a0, g);
     const Vector6 root = d.joint_wrench[0];
     Vector6 weight = Vector6::Zero();
@@ -180,9 +186,8 @@ TEST(Rnea, RandomTreePowerIsTheRateOfEnergy) {
       return E;
     };
     const double dt = 1e-6;
-    const VectorX qm = integrate(m, q0, v0 - a0 * dt, -dt);
-    const VectorX qp = integrate(m, q0, v0, dt);
-    const double Edot = (energy(qp, v0 + a0 * dt) - energy(qm, v0 - a0 * dt)) / (2 * dt);
+    const StepsAround x(m, q0, v0, a0, dt);
+    const double Edot = (energy(x.qp, x.vp) - energy(x.qm, x.vm)) / (2 * dt);
     const double power = rnea(m, d, q0, v0, a0, g).dot(v0);
     EXPECT_NEAR(power, Edot, 1e-4 * std::abs(Edot) + 1e-4) << seed;
   }
