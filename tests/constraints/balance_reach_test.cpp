@@ -15,6 +15,7 @@
 #include "mannequin/constraints/balance.hpp"
 #include "mannequin/constraints/solver.hpp"
 #include "mannequin/constraints/system.hpp"
+#include "mannequin/sim/mannequin_system.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 #include "../common/mannequins.hpp"
@@ -67,7 +68,7 @@ Reach reach(bool balance, bool inscribed, int steps = 3000) {
   options.inscribed = inscribed;
   BalanceRows rows(0, model, ctl.data(), options);
   EXPECT_TRUE(rows.setSupport(support));
-  MannequinSystem system(ctl);
+  sim::MannequinSystem system(ctl);
   ConstraintSolver solver({&system});
   if (balance) solver.addProducer(&rows);
 

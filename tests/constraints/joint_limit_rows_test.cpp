@@ -11,6 +11,7 @@
 #include "mannequin/constraints/system.hpp"
 #include "mannequin/control/config.hpp"
 #include "mannequin/math/so3.hpp"
+#include "mannequin/sim/mannequin_system.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 
@@ -56,7 +57,8 @@ TEST(JointLimitRows, RowsMatchFiniteDifferencesOfTheirDistances) {
   std::normal_distribution<double> n(0, 1);
   control::Controller a(m, postureOnly()), b(m, postureOnly()), c(m, postureOnly());
   // activation 10 rad: every row
-  JointLimitRows pa(a, 0, {10.0, 1.0, 0}), pb(b, 0, {10.0, 1.0, 0}), pc(c, 0, {10.0, 1.0, 0});
+  sim::MannequinSystem sa(a), sb(b), sc(c);
+  JointLimitRows pa(sa, 0, {10.0, 1.0, 0}), pb(sb, 0, {10.0, 1.0, 0}), pc(sc, 0, {10.0, 1.0, 0});
   RowSet ra({m.nv}, 512), rb({m.nv}, 512), rc({m.nv}, 512);
   const double h = 1e-5;
   double worst = 0;
@@ -119,9 +121,9 @@ TEST(JointLimitRows, AKneeDrivenPastItsLimitStopsThere) {
   qd(knee) = -0.5;
   control::Controller ctl(male50(), postureOnly(), q0);
   ctl.setPosture(qd);
-  MannequinSystem sys(ctl);
+  sim::MannequinSystem sys(ctl);
   ConstraintSolver solver({&sys});
-  JointLimitRows limits(ctl, 0);
+  JointLimitRows limits(sys, 0);
   solver.addProducer(&limits);
   double lowest = 1;
   for (int i = 0; i < 3000; ++i) {
@@ -150,9 +152,9 @@ TEST(JointLimitRows, RandomShoulderTargetsNeverLeaveTheConeOrTwistRange) {
   control::ControllerConfig cfg = control::loadControllerConfig("configs/control/default.yaml");
   cfg.gravity.setZero();
   control::Controller ctl(m, cfg);
-  MannequinSystem sys(ctl);
+  sim::MannequinSystem sys(ctl);
   ConstraintSolver solver({&sys});
-  JointLimitRows limits(ctl, 0);
+  JointLimitRows limits(sys, 0);
   solver.addProducer(&limits);
   const int hand = ctl.frameIndex("hand_l");
   const skeleton::Joint& sh = m.joints[m.jointIndex("shoulder_l")];

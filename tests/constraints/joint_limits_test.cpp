@@ -5,6 +5,7 @@
 
 #include "mannequin/constraints/joint_limits.hpp"
 #include "mannequin/math/so3.hpp"
+#include "mannequin/sim/mannequin_system.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 
 #include "male50_fixture.hpp"
@@ -23,7 +24,8 @@ std::vector<double> run(control::Controller& ctl, JointLimits* limits, int k, in
   for (int i = 0; i < steps; ++i) {
     EXPECT_EQ(ctl.computeFreeMotion(), control::StepStatus::kOk);
     if (limits != nullptr) {
-      EXPECT_EQ(limits->apply(ctl), lcp::LcpStatus::Solved);
+      sim::MannequinSystem system(ctl);
+      EXPECT_EQ(limits->apply(system, ctl.config().dt), lcp::LcpStatus::Solved);
     }
     ctl.integrate();
     traj.push_back(ctl.q()(k));
@@ -150,7 +152,8 @@ TEST(JointLimits, FarFromLimitsNothingChangesAndBadOptionsThrow) {
   for (int i = 0; i < 50; ++i) {
     a.step();
     b.computeFreeMotion();
-    EXPECT_EQ(limits.apply(b), lcp::LcpStatus::Solved);
+    sim::MannequinSystem system(b);
+    EXPECT_EQ(limits.apply(system, b.config().dt), lcp::LcpStatus::Solved);
     b.integrate();
   }
   EXPECT_EQ((a.q() - b.q()).norm(), 0.0);

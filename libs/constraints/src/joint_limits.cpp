@@ -52,10 +52,9 @@ double JointLimits::rate(const Coordinate& c, const Eigen::VectorXd& q, const Ei
   return c.component < 0 ? qdot(c.v) : ballRow(c, q).dot(qdot.segment<3>(c.v));
 }
 
-lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
+lcp::LcpStatus JointLimits::apply(ArticulatedSystem& ctl, double dt) {
   const Eigen::VectorXd& q = ctl.q();
   const Eigen::VectorXd& qdot_f = ctl.qdotFree();
-  const double dt = ctl.config().dt;
   const int nv = static_cast<int>(qdot_f.size());
   rows_.clear();
   // candidates: near or past a limit at q_k + δt q̇_f
@@ -86,7 +85,7 @@ lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
       problem_.q(r) = Jc_.row(r).dot(qdot_f) + std::max(d / dt, -options_.recovery_speed);
     }
     BinvJcT_ = Jc_.transpose();
-    ctl.apparentFrictionFactor().solveInPlace(BinvJcT_);  // b⁻¹ J_cᵀ
+    ctl.frictionFactor().solveInPlace(BinvJcT_);  // b⁻¹ J_cᵀ
     problem_.M.noalias() = Jc_ * BinvJcT_;
     lcp::solveLemke(problem_, workspace_, lcp::LemkeOptions{}, res);
     if (res.status != lcp::LcpStatus::Solved) {
@@ -121,7 +120,7 @@ lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
   }
   gamma_.noalias() = Jc_.transpose() * res.z;
   // refused (a non-finite torque): the free motion stays, and the status says the limits did not act
-  if (ctl.applyConstraintForce(gamma_) != control::ForceStatus::kOk) return lcp::LcpStatus::NumericalFailure;
+  if (!ctl.applyConstraintForce(gamma_)) return lcp::LcpStatus::NumericalFailure;
   return res.status;
 }
 
@@ -130,14 +129,14 @@ lcp::LcpStatus JointLimits::apply(control::Controller& ctl) {
 // ---- JointLimitRows: the limits as rows of the shared solver -----------------------------------
 namespace mannequin::constraints {
 
-JointLimitRows::JointLimitRows(const control::Controller& controller, int system, JointLimitOptions options)
-    : ctl_(&controller), system_(system), options_(options) {
+JointLimitRows::JointLimitRows(const ArticulatedSystem& mannequin, int system, JointLimitOptions options)
+    : ctl_(&mannequin), system_(system), options_(options) {
   if (!std::isfinite(options.activation) || options.activation < 0)
     throw std::invalid_argument("joint limit rows: activation must be finite and >= 0");
   if (!std::isfinite(options.recovery_speed) || options.recovery_speed < 0)
     throw std::invalid_argument("joint limit rows: recovery_speed must be finite and >= 0");
   if (system < 0) throw std::invalid_argument("joint limit rows: system index must be >= 0");
-  const skeleton::Model& model = controller.model();
+  const skeleton::Model& model = mannequin.model();
   for (int ji = 0; ji < static_cast<int>(model.joints.size()); ++ji) {
     const skeleton::Joint& j = model.joints[ji];
     if (j.type == skeleton::JointType::kFreeFlyer) continue;

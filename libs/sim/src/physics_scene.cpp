@@ -61,7 +61,7 @@ void World::buildPhysics() {
     // not yet calibrated: no place of its own (it stands where it was built, where the others may
     // stand too), it touches only the static scene and itself
     P.cw.setMannequinPlaced(P.cw_mannequin.back(), false);
-    P.systems.push_back(std::make_unique<constraints::MannequinSystem>(cs->controller()));
+    P.systems.push_back(std::make_unique<MannequinSystem>(cs->controller()));
     P.frames.push_back(std::make_unique<constraints::MannequinFrames>(mp->model, cs->controller().data()));
     systems.push_back(P.systems.back().get());
   }
@@ -139,8 +139,7 @@ void World::buildPhysics() {
   // the joint limits (and swing/twist) in the same LCP as the contacts: each sees the other's force
   if (config_.joint_limits)
     for (std::size_t m = 0; m < mannequins_.size(); ++m) {
-      ControllerStepper& cs = *mannequins_[m]->controller;
-      P.limits.push_back(std::make_unique<constraints::JointLimitRows>(cs.controller(), static_cast<int>(m), *config_.joint_limits));
+      P.limits.push_back(std::make_unique<constraints::JointLimitRows>(*P.systems[m], static_cast<int>(m), *config_.joint_limits));
       P.solver->addProducer(P.limits.back().get());
     }
   P.solver->addProducer(P.contacts.get());

@@ -37,7 +37,7 @@ double worstLimitExcess(const skeleton::Model& model, const skeleton::VectorX& q
 struct World::Physics {
   collision::CollisionWorld cw;
   std::vector<int> cw_mannequin;                       // per mannequin: index in cw
-  std::vector<std::unique_ptr<constraints::MannequinSystem>> systems;
+  std::vector<std::unique_ptr<MannequinSystem>> systems;
   std::vector<std::unique_ptr<constraints::MannequinFrames>> frames;
   std::unique_ptr<constraints::ContactRows> contacts;
   std::vector<std::unique_ptr<constraints::JointLimitRows>> limits;  // per mannequin (joint_limits on)

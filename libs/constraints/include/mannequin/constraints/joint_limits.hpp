@@ -3,8 +3,9 @@
 /// \brief Joint limits as unilateral constraints in the controller's step (thesis 3.7 and Alg. 4, with
 /// constraint rows on the limited coordinates instead of contact normals).
 ///
-/// Stage 2 of control::Controller's step, between computeFreeMotion() and integrate(). With q_k, the
-/// free velocity q̇_f (qdotFree), b the apparent friction (its Cholesky factor) and δt the step:
+/// Stage 2 of a mannequin's step (an ArticulatedSystem, system.hpp; sim::MannequinSystem for the controller),
+/// between its free motion and its integration. With q_k, the free velocity q̇_f (qdotFree), b the apparent
+/// friction (its Cholesky factor) and δt the step:
 /// - candidate j: a coordinate with a finite limit that is within `activation` of it, or would pass it,
 ///   at q_k + δt q̇_f (revolute: the angle; ball: one component of the rotation vector);
 /// - its row J_j (1 × nv) is the rate of that coordinate: s_j e_jᵀ for a revolute coordinate, s_j times a
@@ -14,7 +15,7 @@
 /// - the LCP 0 ≤ w = J_c b⁻¹ J_cᵀ λ + J_c q̇_f + max(d/δt, −v_rec) ⊥ λ ≥ 0 (Lemke, libs/lcp): w_j ≥ 0 keeps
 ///   q_{k+1} on the right side of the limit to first order (a coordinate already past it comes back at
 ///   `recovery_speed` at most, never with a jump), λ_j ≥ 0 (N·m) only pushes, and only at an active limit;
-/// - Γ_c = J_cᵀ λ goes to Controller::applyConstraintForce (q̇ = q̇_f + b⁻¹Γ_c).
+/// - Γ_c = J_cᵀ λ goes to the system's applyConstraintForce (q̇ = q̇_f + b⁻¹Γ_c).
 /// J_c b⁻¹ J_cᵀ is symmetric positive definite for distinct coordinates, so the LCP has one solution.
 /// The forces at the candidates move the other coordinates too (b⁻¹ couples them): a coordinate that
 /// q̇ = q̇_f + b⁻¹J_cᵀλ would carry past its limit joins the candidates and the LCP is solved again
@@ -27,7 +28,6 @@
 #include "mannequin/constraints/rows.hpp"
 #include "mannequin/constraints/solver.hpp"
 #include "mannequin/constraints/swing_twist.hpp"
-#include "mannequin/control/controller.hpp"
 #include "mannequin/lcp/lemke.hpp"
 
 namespace mannequin::constraints {
@@ -49,7 +49,7 @@ struct LimitRow {
 };
 
 /// Joint limits as rows of the shared constraint solver (solver.hpp), for one mannequin (system
-/// `system` of the ConstraintSolver, a MannequinSystem on `controller`). At q_k, for every limit:
+/// `system` of the ConstraintSolver, the ArticulatedSystem `mannequin`). At q_k, for every limit:
 /// - revolute coordinate k (thesis 3.16–3.17): d = q_k − lower (J = e_kᵀ) and upper − q_k (J = −e_kᵀ);
 /// - ball joint with swing/twist limits (Joint::ball_limit, Annex D.2, swing_twist.hpp): one swing
 ///   row d_s (ellipse, rad) and two twist rows θ_t − lower, upper − θ_t, on the ball's 3 velocity
@@ -71,7 +71,7 @@ struct LimitRow {
 class JointLimitRows final : public RowProducer {
  public:
   /// \throws std::invalid_argument on non-finite or negative options or system < 0.
-  JointLimitRows(const control::Controller& controller, int system, JointLimitOptions options = {});
+  JointLimitRows(const ArticulatedSystem& mannequin, int system, JointLimitOptions options = {});
 
   const char* name() const override { return "joint_limits"; }
   void addRows(int id, double dt, RowSet& rows) override;
@@ -108,7 +108,7 @@ class JointLimitRows final : public RowProducer {
   void addBox(int id, RowSet& rows, std::size_t bi, bool upper, double correction);
   /// Appends ball bi's rows at q_k (d: its distances there; correction: 3 values or null).
   void addBall(int id, RowSet& rows, std::size_t bi, const BallLimitDistances& d, const double* correction);
-  const control::Controller* ctl_;
+  const ArticulatedSystem* ctl_;
   int system_;
   JointLimitOptions options_;
   std::vector<Box> boxes_;
@@ -144,10 +144,10 @@ class JointLimits {
   /// \throws std::invalid_argument on non-finite or negative options.
   explicit JointLimits(const skeleton::Model& model, JointLimitOptions options = {});
 
-  /// Stage 2 for `ctl` (built on the same model): after computeFreeMotion(), before integrate().
-  /// Returns Solved when nothing is near a limit or the LCP was solved (the force is then applied);
+  /// Stage 2 for `mannequin` (on the same model; e.g. sim::MannequinSystem on a controller): after its free
+  /// motion, before integration; dt the step (s). Returns Solved when nothing is near a limit or the LCP was solved (the force is then applied);
   /// on any other status nothing is applied and the status is returned (the step goes on unconstrained).
-  lcp::LcpStatus apply(control::Controller& ctl);
+  lcp::LcpStatus apply(ArticulatedSystem& mannequin, double dt);
 
   const std::vector<LimitRow>& rows() const { return rows_; }
   /// Rows with λ > 0 at the last apply().

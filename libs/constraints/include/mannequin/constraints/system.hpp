@@ -4,12 +4,14 @@
 /// the three stages of Alg. 4 — free motion, constraint forces, integration.
 ///
 /// The solver only needs, at q_k after the free motion: nv, q̇_free, the action of b⁻¹ on columns
-/// (b's Cholesky factor, along the tree of coordinates), and a way to add a constraint torque (q̇ = q̇_free + b⁻¹Γ_c). Implementations:
-/// MannequinSystem (a control::Controller, below) and sim's rigid objects.
+/// (b's Cholesky factor, along the tree of coordinates), and a way to add a constraint torque
+/// (q̇ = q̇_free + b⁻¹Γ_c). An ArticulatedSystem also gives its skeleton model and q_k (the joint limits
+/// read them). Implementations: sim::MannequinSystem (a mannequin's control::Controller) and sim's rigid
+/// objects; this library does not depend on the controller.
 #include <Eigen/Dense>
 
-#include "mannequin/control/controller.hpp"
 #include "mannequin/math/tree_cholesky.hpp"
+#include "mannequin/skeleton/model.hpp"
 
 namespace mannequin::constraints {
 
@@ -27,21 +29,13 @@ class ConstrainedSystem {
   virtual bool applyConstraintForce(const Eigen::VectorXd& gamma_c) = 0;
 };
 
-/// A mannequin's controller as a constrained system (stage 2 of control::Controller).
-class MannequinSystem final : public ConstrainedSystem {
+/// A constrained system with a skeleton: its model and its configuration q_k of the current step.
+class ArticulatedSystem : public ConstrainedSystem {
  public:
-  explicit MannequinSystem(control::Controller& controller) : ctl_(&controller) {}
-  int nv() const override { return ctl_->model().nv; }
-  const Eigen::VectorXd& qdotFree() const override { return ctl_->qdotFree(); }
-  const math::TreeCholesky& frictionFactor() const override { return ctl_->apparentFrictionFactor(); }
-  bool applyConstraintForce(const Eigen::VectorXd& gamma_c) override {
-    return ctl_->applyConstraintForce(gamma_c) == control::ForceStatus::kOk;
-  }
-  control::Controller& controller() { return *ctl_; }
-  const control::Controller& controller() const { return *ctl_; }
-
- private:
-  control::Controller* ctl_;
+  virtual const skeleton::Model& model() const = 0;
+  /// q_k (nq), the configuration the free motion was computed at.
+  virtual const Eigen::VectorXd& q() const = 0;
+  int nv() const override { return model().nv; }
 };
 
 }  // namespace mannequin::constraints
