@@ -224,6 +224,7 @@ void Controller::reset(const VectorX& q0) {
   if (q0.size() != model_.nq) throw std::invalid_argument("reset: q has size " + std::to_string(q0.size()) + ", expected " + std::to_string(model_.nq));
   if (!q0.allFinite()) throw std::invalid_argument("reset: q has non-finite values");
   q_ = q0;
+  kinematics_at_q_ = false;
   qdot_.setZero();
   qdot_prev_.setZero();
   clearJointCoupling();
@@ -251,6 +252,7 @@ void Controller::reset(const VectorX& q0) {
   potential_ = 0;
   time_ = 0;
   free_motion_ready_ = false;
+  skeleton::centerOfMass(model_, data_);  // data(): the poses (frameKinematics) and the CoM at q0
 }
 
 TargetStatus Controller::setTarget(int i, const SE3& oMd) { return setTarget(i, oMd, Vector6::Zero()); }
@@ -358,7 +360,9 @@ void Controller::setPosture(const VectorX& q_d) {
 //---- stage 1 pieces ----
 
 void Controller::frameKinematics() {
-  skeleton::computeJointJacobians(model_, data_, q_);
+  if (!kinematics_at_q_) skeleton::forwardKinematics(model_, data_, q_);
+  kinematics_at_q_ = true;
+  skeleton::computeJointJacobians(model_, data_);
   for (int i = 0; i < numFrames(); ++i) {
     ControlFrameState& f = frames_[i];
     f.pose = data_.oMf[f.frame] * f.offset;
@@ -607,6 +611,10 @@ void Controller::integrate() {
   qdot_prev_ = qdot_;
   time_ += dt_;
   free_motion_ready_ = false;
+  // the poses and CoM at q_{k+1}: what the caller reads between steps, and stage 1's forward kinematics
+  skeleton::forwardKinematics(model_, data_, q_);
+  skeleton::centerOfMass(model_, data_);
+  kinematics_at_q_ = true;
 }
 
 StepStatus Controller::step() {

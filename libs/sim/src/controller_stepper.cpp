@@ -10,7 +10,7 @@ namespace mannequin::sim {
 ControllerStepper::ControllerStepper(const skeleton::Model& model, control::ControllerConfig config,
                                      const std::vector<int>& frames, double dt, const skeleton::VectorX& q0,
                                      std::optional<constraints::JointLimitOptions> limits)
-    : model_(model), data_(model), dt_(dt) {
+    : dt_(dt) {
   if (!(dt > 0) || !std::isfinite(dt)) throw std::invalid_argument("controller stepper: step must be > 0");
   config.dt = dt;
   controller_ = std::make_unique<control::Controller>(model, config, q0);
@@ -44,8 +44,8 @@ ControllerStepper::ControllerStepper(const skeleton::Model& model, control::Cont
   for (int c = 0; c < controller_->numFrames(); ++c)
     if (!used[c]) controller_->setFrameEnabled(c, false);
   if (limits) {
-    system_ = std::make_unique<constraints::MannequinSystem>(*controller_);
-    limits_ = std::make_unique<constraints::JointLimitRows>(*controller_, 0, *limits);
+    system_ = std::make_unique<MannequinSystem>(*controller_);
+    limits_ = std::make_unique<constraints::JointLimitRows>(*system_, 0, *limits);
     // joint limits only: at most two rows per coordinate (a swing and a twist row per ball joint)
     constraints::SolverOptions so;
     so.max_rows = 2 * model.nv;
@@ -54,8 +54,6 @@ ControllerStepper::ControllerStepper(const skeleton::Model& model, control::Cont
     solver_ = std::make_unique<constraints::ConstraintSolver>(std::vector<constraints::ConstrainedSystem*>{system_.get()}, so);
     solver_->addProducer(limits_.get());
   }
-  skeleton::forwardKinematics(model_, data_, controller_->q());
-  skeleton::centerOfMass(model_, data_);
 }
 
 void ControllerStepper::setTarget(int i, const math::SE3& oMd, const math::Vector6& V_d, double weight) {
@@ -100,8 +98,6 @@ void ControllerStepper::setPosture(const skeleton::VectorX& q_posture) { control
 
 void ControllerStepper::reset(const skeleton::VectorX& q) {
   controller_->reset(q);
-  skeleton::forwardKinematics(model_, data_, controller_->q());
-  skeleton::centerOfMass(model_, data_);
 }
 
 bool ControllerStepper::step(double dt) { return beginStep(dt, true) && endStep(); }
@@ -117,11 +113,8 @@ bool ControllerStepper::beginStep(double dt, bool own_constraints) {
 }
 
 bool ControllerStepper::endStep() {
-  controller_->integrate();
-  if (!controller_->q().allFinite()) return false;
-  skeleton::forwardKinematics(model_, data_, controller_->q());
-  skeleton::centerOfMass(model_, data_);
-  return true;
+  controller_->integrate();  // also the kinematics and CoM at q_{k+1}, in the controller's Data
+  return controller_->q().allFinite();
 }
 
 }  // namespace mannequin::sim

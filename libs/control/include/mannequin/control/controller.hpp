@@ -26,7 +26,8 @@
 ///   2. (constraint layer, optional) reads data() (kinematics at q_k), apparentFriction() (LLT of b),
 ///      qdotFree(); solves its LCP on J_c b⁻¹ J_cᵀ (3.7); calls applyConstraintForce(J_cᵀ W_c),
 ///      which adds b⁻¹ J_cᵀ W_c to q̇ (Alg. 4). Can be called several times; forces add up.
-///   3. integrate(): port energies with the final q̇, mechanisms step, q ⊕ q̇ δt, energy observer.
+///   3. integrate(): port energies with the final q̇, mechanisms step, q ⊕ q̇ δt, energy observer; the
+///      forward kinematics and CoM at the new q (data(); stage 1 of the next step reuses them).
 /// No heap allocation in any stage after construction (tests/control/alloc_test.cpp).
 ///
 /// Targets: setTarget(frame, oMd) holds a pose (V_d = 0); setTarget(frame, oMd, V_d) also gives
@@ -88,13 +89,16 @@ struct StabilityEntry {
 
 class Controller {
  public:
-  /// Builds the controller for a model (copied) at q0 (default: standing configuration). Targets
-  /// start at the current control-frame poses. Logs a warning for each unstable coupling (2.11).
+  /// Builds the controller for a model at q0 (default: standing configuration). The controller keeps a
+  /// reference to the model (Model/Data: the model is shared, read-only, and must outlive the controller;
+  /// a temporary model does not compile). Targets start at the current control-frame poses. Logs a warning for each unstable coupling (2.11).
   /// \throws std::invalid_argument (prefixed "FILE:LINE: field:" when the config came from a
   /// file) on unknown frame/segment names (listing the valid ones), duplicate names, non-finite
   /// or negative gains, δt ≤ 0, b_a ≤ 0, bad mechanisms, a q0 of the wrong size.
   Controller(const skeleton::Model& model, const ControllerConfig& config);
   Controller(const skeleton::Model& model, const ControllerConfig& config, const VectorX& q0);
+  Controller(skeleton::Model&&, const ControllerConfig&) = delete;
+  Controller(skeleton::Model&&, const ControllerConfig&, const VectorX&) = delete;
 
   //---- state ----
   /// q = q0, q̇ = 0, targets at the current poses, energies and observer reset, mechanisms re-attached,
@@ -104,7 +108,10 @@ class Controller {
   const VectorX& qdot() const { return qdot_; }    ///< (nv) velocity of the last step
   double time() const { return time_; }
   const skeleton::Model& model() const { return model_; }
-  /// Kinematics at q_k (valid after computeFreeMotion(), until integrate()).
+  /// The mannequin's one Data. After computeFreeMotion(), until integrate(): the kinematics at q_k (poses,
+  /// joint Jacobians, CoM and its Jacobian). After integrate() (and reset()): the poses and the CoM at the
+  /// new q, the Jacobians still those of q_k; the next computeFreeMotion() adds the Jacobians without
+  /// computing the forward kinematics again (once per step).
   const skeleton::Data& data() const { return data_; }
   const ControllerConfig& config() const { return config_; }
 
@@ -198,8 +205,9 @@ class Controller {
   void checkFrame(int i) const;
   std::string describe(int i) const;
 
-  skeleton::Model model_;
+  const skeleton::Model& model_;
   skeleton::Data data_;
+  bool kinematics_at_q_ = false;  // data_'s poses are those of q_ (forward kinematics done)
   ControllerConfig config_;
   int nv_ = 0, rows_ = 0;
   double dt_ = 1e-3;

@@ -28,6 +28,7 @@
 #include "mannequin/constraints/solver.hpp"
 #include "mannequin/constraints/system.hpp"
 #include "mannequin/control/controller.hpp"
+#include "mannequin/sim/mannequin_system.hpp"
 #include "mannequin/sim/stepper.hpp"
 
 namespace mannequin::sim {
@@ -53,7 +54,8 @@ class ControllerStepper final : public Stepper {
   bool endStep();
   const skeleton::VectorX& q() const override { return controller_->q(); }
   const skeleton::VectorX& qdot() const override { return controller_->qdot(); }
-  const skeleton::Data& data() const override { return data_; }
+  /// The controller's Data (one per mannequin): poses and CoM at q after each step (Controller::data()).
+  const skeleton::Data& data() const override { return controller_->data(); }
   double portEnergy() const override;
   std::string_view kind() const override { return "controller"; }
 
@@ -86,14 +88,12 @@ class ControllerStepper final : public Stepper {
     math::Vector6 K0, B0;         // gains at weight 1
     double weight = -1.0;         // last weight applied (−1: none yet)
   };
-  const skeleton::Model& model_;
   std::unique_ptr<control::Controller> controller_;
   std::vector<Driven> map_;
-  std::unique_ptr<constraints::MannequinSystem> system_;
+  std::unique_ptr<MannequinSystem> system_;
   std::unique_ptr<constraints::JointLimitRows> limits_;
   std::unique_ptr<constraints::ConstraintSolver> solver_;
   long failures_ = 0;
-  skeleton::Data data_;
   double dt_;
 };
 
