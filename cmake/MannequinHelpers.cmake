@@ -66,7 +66,7 @@ function(mannequin_add_test name)
     return()
   endif()
   add_executable(${name} ${ARG_SOURCES})
-  target_link_libraries(${name} PRIVATE ${ARG_LIBS} mannequin_options GTest::gtest GTest::gtest_main)
+  target_link_libraries(${name} PRIVATE ${ARG_LIBS} mannequin_options mannequin_test_main)
   target_compile_options(${name} PRIVATE ${MANNEQUIN_TEST_CODE_FLAGS})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin/tests
                                            MANNEQUIN_TEST_CODE ON)
