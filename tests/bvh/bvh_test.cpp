@@ -6,6 +6,7 @@
 #include <fstream>
 #include <numbers>
 #include <sstream>
+#include <stdexcept>
 #include <string>
 
 #include "mannequin/skeleton/bvh.hpp"
@@ -118,6 +119,59 @@ TEST(BvhReal, MocapbankCapture) {
   ASSERT_EQ(chest, 1);
   const Vector3 expected = world[0].p + world[0].R * Vector3(-0.1728, 10.2870, 0.1254);
   EXPECT_TRUE(world[1].p.isApprox(expected, 1e-14));
+}
+
+// ---- a converter's T-pose --------------------------------------------------------------------
+
+// A stick figure 1.8 tall: head top at +0.9, feet at -0.9 (file units). Frame 0: both arms (0.7 long from
+// shoulders 0.2 off the axis) spread horizontally, hand to hand 1.8: h/v = 1, a T-pose. Frame 1: the arms hang
+// down (Zrotation -90 and +90): the horizontal extent is shoulder to shoulder, 0.4, h/v = 0.22.
+const char* kStickFigure =
+    "HIERARCHY\nROOT Hips\n{\n OFFSET 0 0 0\n CHANNELS 6 Xposition Yposition Zposition Zrotation Xrotation Yrotation\n"
+    " JOINT Chest\n {\n  OFFSET 0 0.5 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n"
+    "  JOINT LArm\n  {\n   OFFSET 0.2 0.3 0\n   CHANNELS 1 Zrotation\n   End Site\n   {\n    OFFSET 0.7 0 0\n   }\n  }\n"
+    "  JOINT RArm\n  {\n   OFFSET -0.2 0.3 0\n   CHANNELS 1 Zrotation\n   End Site\n   {\n    OFFSET -0.7 0 0\n   }\n  }\n"
+    "  End Site\n  {\n   OFFSET 0 0.4 0\n  }\n }\n"
+    " JOINT LLeg\n {\n  OFFSET 0.1 0 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n  End Site\n  {\n   OFFSET 0 -0.9 0\n  }\n }\n"
+    " JOINT RLeg\n {\n  OFFSET -0.1 0 0\n  CHANNELS 3 Zrotation Xrotation Yrotation\n  End Site\n  {\n   OFFSET 0 -0.9 0\n  }\n }\n"
+    "}\nMOTION\nFrames: 3\nFrame Time: 0.01\n"
+    "0 0 0 0 0 0  0 0 0  0  0  0 0 0  0 0 0\n"
+    "0 0 0 0 0 0  0 0 0  -90  90  0 0 0  0 0 0\n"
+    "0 0 0 0 0 0  0 0 0  -90  90  0 0 0  0 0 0\n";
+
+TEST(BvhTPose, SpreadArmsStandingUprightAreATPoseHangingArmsAreNot) {
+  const sk::Bvh bvh = sk::parseBvh(kStickFigure, "stick");
+  EXPECT_TRUE(sk::bvhIsTPose(bvh, 0));
+  EXPECT_FALSE(sk::bvhIsTPose(bvh, 1));
+  EXPECT_FALSE(sk::bvhIsTPose(bvh, -1));
+  EXPECT_EQ(sk::bvhLeadingTPoseFrames(bvh, 0), 1);
+  EXPECT_EQ(sk::bvhLeadingTPoseFrames(bvh, 1), 0);
+  EXPECT_EQ(sk::bvhLeadingTPoseFrames(bvh, 3), 0);  // past the end: none
+  EXPECT_THROW(sk::bvhIsTPose(bvh, 3), std::out_of_range);
+  // the same spread arms with the whole figure tilted 60° (root Xrotation 60: the trunk leans, as in a stoop):
+  // the horizontal extent stays large (h/v = 2) but the vertical extent is half the upright one of frames 1–2
+  std::string tilted_text = kStickFigure;
+  const std::string upright_frame0 = "0 0 0 0 0 0  0 0 0  0  0";
+  tilted_text.replace(tilted_text.find(upright_frame0), upright_frame0.size(), "0 0 0 0 60 0  0 0 0  0  0");
+  const sk::Bvh tilted = sk::parseBvh(tilted_text, "tilted");
+  EXPECT_FALSE(sk::bvhIsTPose(tilted, 0));
+  EXPECT_EQ(sk::bvhLeadingTPoseFrames(tilted, 0), 0);
+}
+
+TEST(BvhTPose, TheConvertersTPoseOfTheCmuBoxLiftsIsFoundAndNothingElse) {
+  // cgspeed's MotionBuilder conversions add a T-pose as frame 0 (data/README.md); the stoop lift bends the trunk
+  // horizontal with the arms down, which the upright test tells apart
+  for (const char* name : {"cmu_115_02.bvh", "cmu_115_06.bvh"}) {
+    const sk::Bvh bvh = sk::readBvhFile(dataPath(name));
+    EXPECT_TRUE(sk::bvhIsTPose(bvh, 0)) << name;
+    EXPECT_EQ(sk::bvhLeadingTPoseFrames(bvh, 0), 1) << name;
+    int later = 0;
+    for (int f = 1; f < bvh.num_frames; ++f) later += sk::bvhIsTPose(bvh, f) ? 1 : 0;
+    EXPECT_EQ(later, 0) << name;
+  }
+  // captures without one
+  for (const char* name : {"cmu_max_131_03.bvh", "mocapbank_test.bvh"})
+    EXPECT_EQ(sk::bvhLeadingTPoseFrames(sk::readBvhFile(dataPath(name)), 0), 0) << name;
 }
 
 // ---- hand-computed forward kinematics -------------------------------------------------------

@@ -172,6 +172,43 @@ TEST(BvhSource, PublishesTheForwardKinematicsInTheRoomFrame) {
   EXPECT_FALSE(src.finished());
 }
 
+TEST(BvhSource, SkipsTheConvertersTPoseSoThatTheCalibrationTakesTheCapturesFirstFrame) {
+  BvhSourceOptions o;
+  o.file = "data/bvh/cmu_115_02.bvh";
+  o.unit_scale_to_m = skeleton::bvhUnitScale(skeleton::BvhUnit::Cmu);
+  o.bodies = {{"hand_l", "LeftHand"}, {"pelvis", "Hips"}};
+  o.paced = false;
+  BvhSource src(o);
+  EXPECT_EQ(src.skippedTPoseFrames(), 1);
+  EXPECT_EQ(src.firstFrame(), 1);
+  EXPECT_NE(src.describe().find("after 1 T-pose frame"), std::string::npos) << src.describe();
+  const Frame first = *src.next(std::chrono::milliseconds(0));
+  EXPECT_TRUE(first.calibration_pose);
+  EXPECT_EQ(first.frame_number, 0u);
+  EXPECT_EQ(first.stamp_ns, 0);
+  // it is file frame 1: the actor's hand hangs well below the pelvis (in the T-pose it is at shoulder height)
+  const auto world1 = skeleton::bvhWorldPoses(src.bvh(), 1, skeleton::BvhLengthUnit::Metre);
+  const math::Vector3 p = world1[static_cast<std::size_t>(skeleton::findBvhJoint(src.bvh(), "LeftHand"))].p;
+  EXPECT_LT((first.bodies[0].pose.p - math::Vector3(p.z(), p.x(), p.y())).norm(), 1e-12);
+  EXPECT_LT(first.bodies[0].pose.p.z(), first.bodies[1].pose.p.z());
+  // skip_tpose: false plays the file from frame 0, T-pose included
+  o.skip_tpose = false;
+  BvhSource raw(o);
+  EXPECT_EQ(raw.skippedTPoseFrames(), 0);
+  const Frame tpose = *raw.next(std::chrono::milliseconds(0));
+  EXPECT_GT(tpose.bodies[0].pose.p.z(), tpose.bodies[1].pose.p.z() + 0.2);  // the hand above the pelvis
+  // a range made of T-poses only is refused, naming the file
+  o.skip_tpose = true;
+  o.end_frame = 0;
+  try {
+    BvhSource none(o);
+    ADD_FAILURE() << "a T-pose-only range was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("cmu_115_02.bvh"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("T-pose"), std::string::npos) << e.what();
+  }
+}
+
 TEST(BvhSource, EndsWithoutLoopAndRejectsBadRanges) {
   BvhSourceOptions o;
   o.file = "data/bvh/cmu_max_131_03.bvh";

@@ -172,6 +172,21 @@ TEST_F(SimulateTool, TheLeaningWorkerHoldsTheWholeMarginOnlyWithTheHandOnTheWall
   EXPECT_TRUE(r.out.empty()) << r.out;
 }
 
+// The shipped box lift (configs/sim/sim_lift.yaml: CMU 115_02, 401 frames whose frame 0 is the converter's
+// T-pose): the T-pose is skipped, so the run plays the 400 frames of the capture and calibrates on the first of
+// them, the actor standing with the arms down.
+TEST_F(SimulateTool, TheBoxLiftSkipsTheConvertersTPose) {
+  const ToolResult a = run("--config configs/sim/sim_lift.yaml --json --log-level info", 300);
+  ASSERT_EQ(a.exit_code, 0) << a.err;
+  EXPECT_NE(a.err.find("cmu_115_02.bvh: frame 0 is a T-pose"), std::string::npos) << a.err;
+  const auto [status, out] = pythonOn(
+      a.out,
+      "assert d['frames'] == 400, d['frames']\nassert d['nan_steps'] == 0, d\n"
+      "assert d['max_penetration_m'] < 0.01, d\nassert abs(d['sim_time_s'] - 399 / 120.0) < 0.02, d\n"
+      "k = d['kinetics'][0]\nassert abs(k['weight_n'] - 78.5 * 9.81) < 0.5, k\nprint('ok')");
+  EXPECT_EQ(status, 0) << out << a.out;
+}
+
 TEST_F(SimulateTool, ShortDemoRunIsOneDeterministicJsonObjectWithFiniteNumbers) {
   const ToolResult a = run("--config configs/sim/sim_demo.yaml --duration 1 --json");
   ASSERT_EQ(a.exit_code, 0) << a.err;

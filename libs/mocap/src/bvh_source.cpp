@@ -1,6 +1,7 @@
 #include "mannequin/mocap/bvh_source.hpp"
 
 #include <fmt/format.h>
+#include <spdlog/spdlog.h>
 
 #include <cmath>
 #include <stdexcept>
@@ -38,14 +39,28 @@ BvhSource::BvhSource(BvhSourceOptions options) : options_(std::move(options)) {
   }
   if (last_ < first_)
     throw std::invalid_argument(fmt::format("{}: end frame {} before start frame {}", options_.file, last_, first_));
+  if (options_.skip_tpose) {
+    const int n = skeleton::bvhLeadingTPoseFrames(bvh_, first_);
+    if (first_ + n > last_)
+      throw std::invalid_argument(fmt::format("{}: every frame of {}..{} is a T-pose (arms spread, upright): nothing to play "
+                                              "(skip_tpose: false plays them)", options_.file, first_, last_));
+    if (n > 0) {
+      spdlog::info("{}: {} a T-pose (arms spread horizontally, upright): skipped, playback and calibration start at frame {}",
+                   options_.file, n > 1 ? fmt::format("frames {}..{} are", first_, first_ + n - 1) : fmt::format("frame {} is", first_),
+                   first_ + n);
+      first_ += n;
+      skipped_tpose_ = n;
+    }
+  }
   frame_ = first_;
   world_.resize(bvh_.joints.size());
 }
 
 std::string BvhSource::describe() const {
-  return fmt::format("BVH {} ({} frames at {:.1f} Hz, playing {}..{} at rate {}{}, {} bodies)", options_.file,
-                     bvh_.num_frames, 1.0 / bvh_.frame_time, first_, last_, options_.rate, options_.loop ? ", looped" : "",
-                     joints_.size());
+  return fmt::format("BVH {} ({} frames at {:.1f} Hz, playing {}..{}{} at rate {}{}, {} bodies)", options_.file,
+                     bvh_.num_frames, 1.0 / bvh_.frame_time, first_, last_,
+                     skipped_tpose_ > 0 ? fmt::format(" after {} T-pose frame{}", skipped_tpose_, skipped_tpose_ > 1 ? "s" : "") : "",
+                     options_.rate, options_.loop ? ", looped" : "", joints_.size());
 }
 
 Frame BvhSource::frameAt(int frame, std::uint64_t loops) const {

@@ -32,7 +32,7 @@ namespace {
 
 std::unique_ptr<Source> makeBvh(const ConfigNode& c) {
   c.allowOnly({"file", "map", "unit_scale_to_m", "bodies", "rate", "loop", "start_frame", "end_frame", "paced",
-               "mark_calibration"});
+               "mark_calibration", "skip_tpose"});
   BvhSourceOptions o;
   try {
     o.file = core::findData(c["file"].str());
@@ -71,6 +71,7 @@ std::unique_ptr<Source> makeBvh(const ConfigNode& c) {
   o.end_frame = c.get("end_frame", -1LL);
   o.paced = c.get("paced", true);
   o.mark_calibration = c.get("mark_calibration", true);
+  o.skip_tpose = c.get("skip_tpose", true);
   try {
     return std::make_unique<BvhSource>(o);
   } catch (const std::exception& e) {

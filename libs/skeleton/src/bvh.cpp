@@ -8,6 +8,7 @@
 #include <climits>
 #include <cmath>
 #include <fstream>
+#include <limits>
 #include <numbers>
 #include <sstream>
 #include <unordered_map>
@@ -538,6 +539,49 @@ std::vector<math::SE3> bvhWorldPoses(const Bvh& bvh, long long frame, BvhLengthU
   std::vector<math::SE3> world(bvh.joints.size());
   bvhForwardKinematics(bvh, bvhFrame(bvh, f), world, unit == BvhLengthUnit::Metre ? bvh.unit_scale_to_m : 1.0);
   return world;
+}
+
+namespace {
+// horizontal (x, z; only when asked: quadratic in the joints) and vertical (y) extents of the frame's joints
+// and End Sites, in file units
+std::pair<double, double> bvhExtents(const Bvh& bvh, int frame, std::vector<math::SE3>& world, bool horizontal_too) {
+  bvhForwardKinematics(bvh, bvhFrame(bvh, frame), world);
+  double horizontal = 0, lo = std::numeric_limits<double>::infinity(), hi = -lo;
+  for (std::size_t a = 0; a < world.size(); ++a) {
+    lo = std::min(lo, world[a].p.y());
+    hi = std::max(hi, world[a].p.y());
+    if (horizontal_too)
+      for (std::size_t b = a + 1; b < world.size(); ++b)
+        horizontal = std::max(horizontal, std::hypot(world[a].p.x() - world[b].p.x(), world[a].p.z() - world[b].p.z()));
+  }
+  return {horizontal, world.empty() ? 0.0 : hi - lo};
+}
+
+struct TPoseTest {
+  explicit TPoseTest(const Bvh& bvh) : bvh_(bvh), world_(bvh.joints.size()) {
+    for (int f = 0; f < bvh.num_frames; ++f) tallest_ = std::max(tallest_, bvhExtents(bvh, f, world_, false).second);
+  }
+  bool operator()(int frame) {
+    const auto [h, v] = bvhExtents(bvh_, frame, world_, true);
+    return v > 0 && h >= kBvhTPoseSpread * v && v >= kBvhTPoseUpright * tallest_;
+  }
+  const Bvh& bvh_;
+  std::vector<math::SE3> world_;
+  double tallest_ = 0;
+};
+}  // namespace
+
+bool bvhIsTPose(const Bvh& bvh, long long frame) {
+  const int f = resolveBvhFrame(bvh, frame);
+  return TPoseTest(bvh)(f);
+}
+
+int bvhLeadingTPoseFrames(const Bvh& bvh, int from) {
+  if (from < 0 || from >= bvh.num_frames) return 0;
+  TPoseTest is_tpose(bvh);
+  int n = 0;
+  while (from + n < bvh.num_frames && is_tpose(from + n)) ++n;
+  return n;
 }
 
 }  // namespace mannequin::skeleton

@@ -23,6 +23,9 @@ struct BvhSourceOptions {
   long long end_frame = -1;  ///< inclusive; negative counts from the end
   bool paced = true;     ///< false: frames as fast as next() is called (tests, benchmarks)
   bool mark_calibration = true;  ///< flag the first frame as the calibration pose
+  /// Skip the T-pose frames a converter puts before the capture (skeleton::bvhIsTPose) from start_frame on,
+  /// so that neither the playback nor the calibration (the first frame) sees them.
+  bool skip_tpose = true;
 };
 
 class BvhSource final : public Source {
@@ -36,12 +39,18 @@ class BvhSource final : public Source {
   const skeleton::Bvh& bvh() const { return bvh_; }
   /// The frame of file frame `frame` played `loops` times before (no pacing, no side effect).
   Frame frameAt(int frame, std::uint64_t loops) const;
+  /// File frames played: firstFrame()..lastFrame() (after the T-pose frames skipped).
+  int firstFrame() const { return first_; }
+  int lastFrame() const { return last_; }
+  /// Leading T-pose frames skipped (options.skip_tpose).
+  int skippedTPoseFrames() const { return skipped_tpose_; }
 
  private:
   BvhSourceOptions options_;
   skeleton::Bvh bvh_;
   std::vector<int> joints_;
   int first_ = 0, last_ = 0;
+  int skipped_tpose_ = 0;
   int frame_ = 0;
   std::uint64_t loops_ = 0;
   bool finished_ = false;

@@ -134,4 +134,19 @@ enum class BvhLengthUnit : std::uint8_t { File, Metre };
 /// positions in file units or metres. \throws std::out_of_range for a bad frame.
 std::vector<math::SE3> bvhWorldPoses(const Bvh& bvh, long long frame, BvhLengthUnit unit = BvhLengthUnit::File);
 
+/// A converter's T-pose (arms spread horizontally, standing upright; e.g. the frame 0 that cgspeed's CMU
+/// conversions add before the capture). Over every entry of bvh.joints (End Sites included) at one frame:
+/// the horizontal extent h (largest distance between two entries projected on the floor, the plane normal to
+/// the file's y axis) and the vertical extent v (along y). A frame is a T-pose when h ≥ kBvhTPoseSpread · v
+/// (arm span is about the stature: h/v ≈ 1; standing arms down ≈ 0.3, a stride ≈ 0.5) and it stands upright:
+/// v ≥ kBvhTPoseUpright · the largest v of the capture (a stoop, where the trunk is horizontal, also has a
+/// large h/v, but a small v). Names no joint, so it holds for any skeleton.
+inline constexpr double kBvhTPoseSpread = 0.8;
+inline constexpr double kBvhTPoseUpright = 0.9;
+/// Whether frame `frame` (negative = from the end) is a T-pose. \throws std::out_of_range for a bad frame.
+bool bvhIsTPose(const Bvh& bvh, long long frame);
+/// How many frames from `from` on (resolved, not negative) are T-poses before the first that is not; stops
+/// at the last frame (all T-poses: num_frames − from).
+int bvhLeadingTPoseFrames(const Bvh& bvh, int from);
+
 }  // namespace mannequin::skeleton
