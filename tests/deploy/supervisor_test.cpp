@@ -15,15 +15,11 @@
 
 #include "mannequin/core/process.hpp"
 #include "mannequin/deploy/supervisor.hpp"
+#include "../common/tool_run.hpp"
 
 using namespace mannequin::deploy;
 
 namespace {
-std::string runDir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  return (std::filesystem::temp_directory_path() / ("mq-deploy-" + std::string(info->name()) + "-" + std::to_string(getpid())))
-      .string();
-}
 
 using mannequin::core::processGone;
 
@@ -40,7 +36,8 @@ bool waitFor(Cond cond, std::chrono::seconds timeout) {
 }  // namespace
 
 TEST(Supervisor, RunsRestartsStopsAndLeavesNoProcess) {
-  const std::string dir = runDir();
+  const mannequin::testutil::TempDir tmp("mq-deploy");  // removed after the test, however it ends
+  const std::string dir = tmp.path().string();
   const Deployment d = parseDeployment(R"(name: test
 heartbeat_timeout: 2
 stop_timeout: 3
@@ -122,7 +119,8 @@ services:
 }
 
 TEST(Supervisor, StopFlagEndsTheRunAndCrashedServicesAreRestarted) {
-  const std::string dir = runDir();
+  const mannequin::testutil::TempDir tmp("mq-deploy");  // removed after the test, however it ends
+  const std::string dir = tmp.path().string();
   // a service killed by a signal is restarted; the launcher's stop flag ends everything
   const Deployment d = parseDeployment(R"(name: test2
 services:

@@ -33,12 +33,6 @@ using namespace mannequin::sim;
 namespace {
 using mannequin::testing::pose;
 
-std::string tempDir() {
-  const auto* info = ::testing::UnitTest::GetInstance()->current_test_info();
-  auto p = std::filesystem::temp_directory_path() / ("mq-sim-" + std::string(info->name()) + "-" + std::to_string(getpid()));
-  std::filesystem::create_directories(p);
-  return p.string();
-}
 }  // namespace
 
 TEST(SimConfig, ErrorsNameFileLineAndField) {
@@ -214,10 +208,10 @@ TEST(SimService, ReplayModeIsDeterministicByteForByte) {
   // a BVH-like stream of 20 frames at 120 Hz (pelvis swaying, hands moving)
   std::vector<v1::MocapFrame> frames;
   for (int k = 0; k < 20; ++k) frames.push_back(actorFrame(k));
-  const std::string dir = tempDir();
+  const mannequin::testutil::TempDir tmp("mq-sim");  // removed after the test, however it ends
+  const std::string dir = tmp.path().string();
   const auto a = replayOnce(frames, dir, 9);
   const auto b = replayOnce(frames, dir, 9);
-  std::filesystem::remove_all(dir);
   // 19 intervals of 1/120 s = 158 steps of 1 ms → sim.world at 60 Hz: 9 states
   ASSERT_EQ(a.size(), 9u);
   ASSERT_EQ(a.size(), b.size());
@@ -240,9 +234,9 @@ TEST(SimService, WorldStateCarriesTheSceneObjectsAtRestOnTheTable) {
   cfg.world.physics.scene = collision::loadScene("configs/scenes/table.yaml");
   std::vector<v1::MocapFrame> frames;
   for (int k = 0; k < 60; ++k) frames.push_back(actorFrame(k));  // 0.49 s
-  const std::string dir = tempDir();
+  const mannequin::testutil::TempDir tmp("mq-sim");  // removed after the test, however it ends
+  const std::string dir = tmp.path().string();
   const auto worlds = replayRun(cfg, {{"mocap", frames}}, dir);
-  std::filesystem::remove_all(dir);
   ASSERT_GE(worlds.size(), 20u);
   for (const std::size_t i : {std::size_t{0}, worlds.size() - 1}) {
     v1::WorldState w;
@@ -422,7 +416,8 @@ TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {
   // two capture systems (two mocap services "mocap_a" and "mocap_b", each with its own clock: b's
   // starts at 1000 s) with the same body names; actor a stands at the origin, actor b 3 m away. The
   // two feeds go in lockstep, as two live systems running at once would send them (replayRun)
-  const std::string dir = tempDir();
+  const mannequin::testutil::TempDir tmp("mq-sim");  // removed after the test, however it ends
+  const std::string dir = tmp.path().string();
   const std::string yaml = "step: 0.001\nworld_rate: 60\nstepper: controller\n"
                            "physics: {enabled: true, scene: configs/scenes/floor.yaml}\n"
                            "mocap_sources:\n"
@@ -442,7 +437,6 @@ TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {
     b.frames.push_back(actorFrame(k, at_b, clock_b));
   }
   const auto worlds = replayRun(cfg, {a, b}, dir, /*lockstep=*/true);
-  std::filesystem::remove_all(dir);
   ASSERT_FALSE(worlds.empty());
   v1::WorldState w;
   ASSERT_TRUE(w.ParseFromString(worlds.back()));
@@ -478,7 +472,8 @@ TEST(SimService, TwoMocapSourcesDriveTwoMannequins) {
 // network (scenario.trigger, on a publisher the sim connects to) switches the right hand from the capture
 // to an autonomous reach; sim.world reports each control frame's mode; scenario.state reports the state.
 TEST(SimService, ATriggerOnTheNetworkSwitchesTheScenarioAndTheWorldReportsTheModes) {
-  const std::string dir = tempDir();
+  const mannequin::testutil::TempDir tmp("mq-sim");  // removed after the test, however it ends
+  const std::string dir = tmp.path().string();
   const std::string sc_path = dir + "/reach.yaml";
   {
     std::ofstream f(sc_path);
@@ -560,7 +555,8 @@ TEST(TriggerTool, SendsOnceToASubscriberAndRefusesBadTriggers) {
   namespace fs = std::filesystem;
   const fs::path tool = testutil::binDir() / "mannequin-trigger";
   ASSERT_TRUE(fs::exists(tool)) << tool;
-  const std::string dir = tempDir();
+  const mannequin::testutil::TempDir tmp("mq-sim");  // removed after the test, however it ends
+  const std::string dir = tmp.path().string();
   const std::string endpoint = "ipc://" + dir + "/trigger";
   testutil::Child child({tool.string(), "go", "--value", "3", "--publish", endpoint, "--wait", "30"}, dir + "/trigger.log");
   ASSERT_TRUE(child.started());
@@ -601,7 +597,8 @@ TEST(SimTool, ScenarioOptionReplacesTheConfigsScenario) {
   namespace fs = std::filesystem;
   const fs::path tool = testutil::binDir() / "mannequin-sim";
   ASSERT_TRUE(fs::exists(tool)) << tool;
-  const std::string dir = tempDir();
+  const mannequin::testutil::TempDir tmp("mq-sim");  // removed after the test, however it ends
+  const std::string dir = tmp.path().string();
   const std::string common = tool.string() + " --config configs/sim/sim_ball.yaml --publish ipc://" + dir + "/sim --connect ipc://" + dir +
                              "/mocap --duration 0.3";
   const testutil::ToolResult same = testutil::runTool(common + " --scenario configs/scenarios/ball.yaml", 60);
