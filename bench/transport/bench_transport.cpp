@@ -58,13 +58,22 @@ simservice::SimServiceConfig simDemoConfig() {
   return cfg;
 }
 
+// the ipc sockets' directory, made on first use and removed when the executable exits
+struct IpcDir {
+  std::string path;
+  ~IpcDir() {
+    std::error_code ec;  // a destructor does not throw: what cannot be removed stays
+    std::filesystem::remove_all(path, ec);
+  }
+};
+
 std::string ipcDir() {
-  static const std::string dir = [] {
+  static const IpcDir dir{[] {
     auto p = std::filesystem::temp_directory_path() / ("bench-transport-" + std::to_string(getpid()));
     std::filesystem::create_directories(p);
     return p.string();
-  }();
-  return dir;
+  }()};
+  return dir.path;
 }
 
 /// The count of the subscriber that has received the fewest messages.
