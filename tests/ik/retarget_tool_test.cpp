@@ -34,5 +34,18 @@ TEST(RetargetTool, WritesAReadableBvhAndReportsLevels) {
   EXPECT_EQ(run("data/bvh/cmu_max_131_03.bvh --mannequin data/README.md --out " + out), 1);
 }
 
+// cgspeed's MotionBuilder conversions start with a T-pose (data/README.md): without --start it is skipped, so the
+// calibration ('first') takes the actor standing
+TEST(RetargetTool, SkipsTheConvertersTPoseUnlessAStartIsGiven) {
+  const std::string out = ::testing::TempDir() + "retarget_tpose.bvh";
+  ASSERT_EQ(run("data/bvh/cmu_115_02.bvh --map configs/mappings/cmu_mb.yaml --end 6 --out " + out), 0);
+  EXPECT_EQ(skeleton::readBvhFile(out).num_frames, 5);  // frames 1..5
+  std::ifstream log("/tmp/mannequin-retarget-test.log");
+  const std::string text((std::istreambuf_iterator<char>(log)), {});
+  EXPECT_NE(text.find("cmu_115_02.bvh: frame 0 is a T-pose"), std::string::npos) << text;
+  ASSERT_EQ(run("data/bvh/cmu_115_02.bvh --map configs/mappings/cmu_mb.yaml --start 0 --end 6 --out " + out), 0);
+  EXPECT_EQ(skeleton::readBvhFile(out).num_frames, 6);  // asked for: frames 0..5
+}
+
 }  // namespace
 }  // namespace mannequin::ik

@@ -1,5 +1,6 @@
 // mannequin-retarget: retargets a BVH capture onto a mannequin with the strict-priority IK and
 // writes the mannequin's motion as BVH; prints per-level residual statistics.
+#include <fmt/format.h>
 #include <spdlog/spdlog.h>
 
 #include <algorithm>
@@ -27,7 +28,8 @@ int main(int argc, char** argv) {
   app.add_option("--out", out_path, "output BVH file (the mannequin's skeleton and motion)")->required();
   app.add_option("--calibration", calibration, "calibration pose: 'first' (first retargeted frame) or 'rest' (BVH rest pose)")
       ->capture_default_str()->check(CLI::IsMember({"first", "rest"}));
-  app.add_option("--start", start, "first frame")->capture_default_str()->check(CLI::NonNegativeNumber);
+  CLI::Option* start_option = app.add_option("--start", start, "first frame (default: the first that is not a converter's T-pose)")
+                                  ->check(CLI::NonNegativeNumber);
   app.add_option("--end", end, "frame after the last one (-1: to the end)")->capture_default_str();
   app.add_option("--max-iterations", max_iterations, "IK iterations per frame")->capture_default_str()->check(CLI::Range(1, 1000));
 
@@ -39,6 +41,15 @@ int main(int argc, char** argv) {
     read_options.unit_scale_to_m = map.unit_scale_to_m;
     const skeleton::Bvh bvh = skeleton::readBvhFile(in_path, read_options);
     if (bvh.num_frames == 0) throw std::runtime_error(in_path + ": the capture has no frames");
+    // a converter's T-pose before the capture (skeleton::bvhIsTPose) would be the calibration pose: skipped
+    if (start_option->count() == 0) {
+      const int tpose = skeleton::bvhLeadingTPoseFrames(bvh, 0);
+      if (tpose > 0 && tpose < bvh.num_frames) {
+        spdlog::info("{}: {} a T-pose (arms spread horizontally, upright): skipped, --start {}", in_path,
+                     tpose > 1 ? fmt::format("frames 0..{} are", tpose - 1) : std::string("frame 0 is"), tpose);
+        start = tpose;
+      }
+    }
     const long long last = end < 0 ? bvh.num_frames : std::min<long long>(end, bvh.num_frames);
     if (start >= last)
       throw std::runtime_error("empty frame range [" + std::to_string(start) + ", " + std::to_string(last) + ") of " +
