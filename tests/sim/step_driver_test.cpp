@@ -10,20 +10,13 @@
 #include "mannequin/sim/world.hpp"
 #include "../common/mannequins.hpp"
 #include "../common/pose.hpp"
+#include "actor.hpp"
 
 using namespace mannequin;
 using namespace mannequin::sim;
 using mannequin::testing::pose;
 
 namespace {
-
-std::vector<MannequinSetup> operatorSetup() {
-  MannequinSetup s;
-  s.name = "operator";
-  s.model = mannequin::testing::male50();
-  s.frames = {{"pelvis", "pelvis"}, {"hand_l", "hand_l"}};
-  return {std::move(s)};
-}
 
 mocap::Frame frameAt(std::int64_t stamp_ns, double hand_x) {
   mocap::Frame f;
@@ -37,7 +30,7 @@ mocap::Frame frameAt(std::int64_t stamp_ns, double hand_x) {
 
 TEST(StepDriver, StepsToEachFramesCaptureTimeWithTheHooksAroundEveryStep) {
   SimConfig cfg;  // δt = 1 ms
-  World world(operatorSetup(), cfg);
+  World world(mannequin::testing::pelvisAndLeftHandOperator(), cfg);
   StepDriver driver(world);
   int before = 0, after = 0;
   bool after_saw_step = true;
@@ -73,7 +66,7 @@ TEST(StepDriver, StepsToEachFramesCaptureTimeWithTheHooksAroundEveryStep) {
 
 TEST(StepDriver, ProceedStopsTheStepsAndAFarDriftReanchorsTheSourceClock) {
   SimConfig cfg;
-  World world(operatorSetup(), cfg);
+  World world(mannequin::testing::pelvisAndLeftHandOperator(), cfg);
   StepDriver driver(world);
   long allowed = 4;
   driver.setHooks({[&] { return allowed-- > 0; }, {}, {}});
@@ -103,7 +96,7 @@ TEST(RateDivider, TicksAtTheExactAverageRate) {
 
 TEST(RunTotals, AddsTrackingErrorsOfTheCalibratedHandsAndCountsSteps) {
   SimConfig cfg;
-  World world(operatorSetup(), cfg);
+  World world(mannequin::testing::pelvisAndLeftHandOperator(), cfg);
   RunTotals totals;
   totals.reset(world.numMannequins());
   EXPECT_TRUE(std::isnan(totals.meanHandError()));

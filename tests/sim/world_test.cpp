@@ -13,6 +13,7 @@
 #include "mannequin/sim/world.hpp"
 #include "../common/mannequins.hpp"
 #include "../common/pose.hpp"
+#include "actor.hpp"
 
 using namespace mannequin;
 using namespace mannequin::sim;
@@ -26,14 +27,6 @@ mocap::Frame frame(std::int64_t stamp_ns, std::vector<mocap::Body> bodies) {
   f.sequence = static_cast<std::uint64_t>(stamp_ns / 1000000 + 1);
   f.bodies = std::move(bodies);
   return f;
-}
-
-std::vector<MannequinSetup> oneMannequin() {
-  MannequinSetup s;
-  s.name = "operator";
-  s.model = mannequin::testing::male50();
-  s.frames = {{"pelvis", "pelvis"}, {"hand_l", "hand_l"}};
-  return {std::move(s)};
 }
 
 TEST(MocapBuffer, InterpolatesHoldsAndReportsOcclusion) {
@@ -57,7 +50,7 @@ TEST(MocapBuffer, InterpolatesHoldsAndReportsOcclusion) {
 
 TEST(World, CalibratesOntoControlFramesAndTracksAMovedBody) {
   SimConfig cfg;
-  World w(oneMannequin(), cfg);
+  World w(mannequin::testing::pelvisAndLeftHandOperator(), cfg);
   EXPECT_FALSE(w.calibrated(0));
   // the actor stands 2 m away, turned 90° about z; the hand body is 10 cm off the mannequin's hand
   const math::SE3 pelvis = pose({2, 1, 0.95}, {0, 0, std::numbers::pi / 2});
@@ -91,7 +84,7 @@ TEST(World, OcclusionHoldsThenBlendsToPostureThenComesBackWithoutJump) {
   SimConfig cfg;
   cfg.occlusion_hold = 0.1;
   cfg.occlusion_blend = 0.2;
-  World w(oneMannequin(), cfg);
+  World w(mannequin::testing::pelvisAndLeftHandOperator(), cfg);
   const math::SE3 pelvis = pose({0, 0, 0.95});
   const math::SE3 hand = pose({0.3, 0.3, 1.1});  // hand raised
   w.addMocap(frame(0, {{"pelvis", pelvis, true}, {"hand_l", hand, true}}));
@@ -115,7 +108,7 @@ TEST(World, OcclusionHoldsThenBlendsToPostureThenComesBackWithoutJump) {
 }
 
 TEST(World, RejectsUnknownFrames) {
-  auto m = oneMannequin();
+  auto m = mannequin::testing::pelvisAndLeftHandOperator();
   m[0].frames.push_back({"tail", "tail"});
   EXPECT_THROW(World(std::move(m), SimConfig{}), std::invalid_argument);
 }
