@@ -6,14 +6,8 @@
 // and fails if none came. Messages from child processes (system tests) are not seen here: those tests
 // read the child's output themselves.
 #include <cstddef>
-#include <string>
 
 namespace mannequin::testing {
-
-/// Error-level messages logged since the current test started, expected or not.
-std::size_t errorLogCount();
-/// The first one logged outside every ExpectErrorLog scope ("" if none).
-std::string firstErrorLog();
 
 /// In its scope, error-level logs are expected: the test fails if the scope ends without one.
 class ExpectErrorLog {

@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <memory>
 #include <mutex>
+#include <string>
 
 #include "error_log.hpp"
 
@@ -85,9 +86,6 @@ class ErrorLogListener final : public ::testing::EmptyTestEventListener {
 };
 
 }  // namespace
-
-std::size_t errorLogCount() { return sink()->total(); }
-std::string firstErrorLog() { return sink()->firstUnexpected(); }
 
 ExpectErrorLog::ExpectErrorLog() : before_(sink()->total()) { ++expecting(); }
 ExpectErrorLog::~ExpectErrorLog() {
