@@ -576,6 +576,14 @@ bool bvhIsTPose(const Bvh& bvh, long long frame) {
   return TPoseTest(bvh)(f);
 }
 
+std::vector<int> bvhTPoseFrames(const Bvh& bvh) {
+  TPoseTest is_tpose(bvh);
+  std::vector<int> frames;
+  for (int f = 0; f < bvh.num_frames; ++f)
+    if (is_tpose(f)) frames.push_back(f);
+  return frames;
+}
+
 int bvhLeadingTPoseFrames(const Bvh& bvh, int from) {
   if (from < 0 || from >= bvh.num_frames) return 0;
   TPoseTest is_tpose(bvh);

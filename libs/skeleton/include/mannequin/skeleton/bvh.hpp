@@ -143,8 +143,11 @@ std::vector<math::SE3> bvhWorldPoses(const Bvh& bvh, long long frame, BvhLengthU
 /// large h/v, but a small v). Names no joint, so it holds for any skeleton.
 inline constexpr double kBvhTPoseSpread = 0.8;
 inline constexpr double kBvhTPoseUpright = 0.9;
-/// Whether frame `frame` (negative = from the end) is a T-pose. \throws std::out_of_range for a bad frame.
+/// Whether frame `frame` (negative = from the end) is a T-pose. Each call measures every frame of the capture
+/// (for its largest v); to test many frames, bvhTPoseFrames. \throws std::out_of_range for a bad frame.
 bool bvhIsTPose(const Bvh& bvh, long long frame);
+/// Every frame that is a T-pose, in increasing order (two passes over the capture).
+std::vector<int> bvhTPoseFrames(const Bvh& bvh);
 /// How many frames from `from` on (resolved, not negative) are T-poses before the first that is not; stops
 /// at the last frame (all T-poses: num_frames − from).
 int bvhLeadingTPoseFrames(const Bvh& bvh, int from);
