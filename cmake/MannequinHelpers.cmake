@@ -32,6 +32,43 @@ if(MANNEQUIN_CHECK_RUNTIME_MALLOC)
   target_compile_options(mannequin_options INTERFACE -UNDEBUG)
 endif()
 
+# mannequin_use_pch(<target> test|tool)
+# The harness code (test executables: kind `test`; tools and service mains: kind `tool`) is compiled at -O1
+# (MANNEQUIN_TEST_CODE_FLAGS), where parsing the Eigen, GoogleTest, CLI11, spdlog, yaml-cpp and protobuf
+# headers is a large share of each source's compile time. With MANNEQUIN_PCH those headers
+# (cmake/pch/<kind>.hpp) are parsed once per build tree, by the target mannequin_pch_<kind>, and every
+# harness target of that kind reuses the result (REUSE_FROM). A precompiled header is only valid with the
+# flags and definitions it was built with, so the host gets the harness code's flags and the consumers the
+# host's third-party dependencies (mannequin_pch_<kind>_deps); GCC warns of a header it cannot use
+# (-Winvalid-pch, an error under MANNEQUIN_WERROR), so a flag added to one side only fails the build.
+function(mannequin_use_pch target kind)
+  if(NOT MANNEQUIN_PCH)
+    return()
+  endif()
+  set(host mannequin_pch_${kind})
+  if(NOT TARGET ${host})
+    add_library(${host}_deps INTERFACE)
+    target_link_libraries(${host}_deps INTERFACE Eigen3::Eigen spdlog::spdlog yaml-cpp)
+    if(kind STREQUAL "test")
+      target_link_libraries(${host}_deps INTERFACE GTest::gtest)
+    elseif(kind STREQUAL "tool")
+      target_link_libraries(${host}_deps INTERFACE CLI11::CLI11)
+    else()
+      message(FATAL_ERROR "mannequin_use_pch(${target} ${kind}): the kind is test or tool")
+    endif()
+    add_executable(${host} EXCLUDE_FROM_ALL ${PROJECT_SOURCE_DIR}/cmake/pch/host.cpp)
+    target_link_libraries(${host} PRIVATE ${host}_deps mannequin_options)
+    target_compile_options(${host} PRIVATE ${MANNEQUIN_TEST_CODE_FLAGS})
+    target_precompile_headers(${host} PRIVATE ${PROJECT_SOURCE_DIR}/cmake/pch/${kind}.hpp)
+    set_target_properties(${host} PROPERTIES UNITY_BUILD OFF)
+    if(kind STREQUAL "test")
+      set_target_properties(${host} PROPERTIES MANNEQUIN_TEST_CODE ON)
+    endif()
+  endif()
+  target_link_libraries(${target} PRIVATE ${host}_deps)
+  target_precompile_headers(${target} REUSE_FROM ${host})
+endfunction()
+
 # mannequin_add_library(<name> SOURCES ... [DEPS ...] [PRIVATE_DEPS ...])
 # Creates target mannequin_<name> (alias mannequin::<name>) with headers in
 # libs/<name>/include/mannequin/<name>/.
@@ -70,6 +107,7 @@ function(mannequin_add_test name)
   target_compile_options(${name} PRIVATE ${MANNEQUIN_TEST_CODE_FLAGS})
   set_target_properties(${name} PROPERTIES RUNTIME_OUTPUT_DIRECTORY ${CMAKE_BINARY_DIR}/bin/tests
                                            MANNEQUIN_TEST_CODE ON)
+  mannequin_use_pch(${name} test)
   add_dependencies(all-tests ${name})
   foreach(tool ${ARG_TOOLS})
     if(TARGET ${tool})
@@ -124,4 +162,5 @@ function(mannequin_add_tool tool)
   # a tool's own sources (command line, file formats, reports) are harness code: its numerical work is in
   # the libraries it links, which keep the build type's flags
   target_compile_options(mannequin-${tool} PRIVATE ${MANNEQUIN_TEST_CODE_FLAGS})
+  mannequin_use_pch(mannequin-${tool} tool)
 endfunction()
