@@ -18,6 +18,7 @@
 #include <vector>
 
 #include "mannequin/skeleton/anthropometry.hpp"
+#include "mannequin/skeleton/dynamics.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 #include "mannequin/math/so3.hpp"
 
@@ -322,6 +323,73 @@ TEST(MjcfMujoco, RandomTreeForwardKinematicsMatchesAtRandomConfigurations) {
           EXPECT_NEAR(d->xpos[3 * b + k], ours.oMi[j].p[k], 1e-9) << seed << " " << model.joints[j].name;
           for (int l = 0; l < 3; ++l) EXPECT_NEAR(d->xmat[9 * b + 3 * k + l], ours.oMi[j].R(k, l), 1e-9);
         }
+      }
+    }
+    mj_deleteData(d);
+    mj_deleteModel(m);
+  }
+}
+#endif
+
+#ifdef MANNEQUIN_HAVE_MUJOCO
+TEST(MjcfMujoco, InverseDynamicsMatchesMujocosRneAtRandomStates) {
+  // rnea (skeleton/dynamics.hpp) against MuJoCo's recursive Newton-Euler (mj_rne: M(q) q̈ + bias, gravity
+  // included) on the same tree at random (q, v, a). Coordinates: revolute and ball velocities are MuJoCo's
+  // (a ball's: the child's angular velocity in its own frame); the free flyer's v = (ω_b, v_b) is the root's
+  // body twist, MuJoCo's free joint (ṗ in the world, ω_b), so with R the root's orientation
+  //   qvel = (R v_b, ω_b),  qacc = (R (v̇_b + ω_b × v_b), ω̇_b),  and its force (R f_b, n_b) for τ = (n_b, f_b).
+  for (unsigned seed : {3u, 11u}) {
+    const Model model = randomTree(seed, 15);
+    std::string error;
+    mjModel* m = loadMujoco(toMjcf(model), error);
+    ASSERT_NE(m, nullptr) << error;
+    ASSERT_EQ(m->nv, model.nv);
+    mjData* d = mj_makeData(m);
+    Data ours(model);
+    std::srand(seed);
+    std::vector<mjtNum> res(static_cast<std::size_t>(m->nv));
+    for (int trial = 0; trial < 5; ++trial) {
+      const VectorX q = VectorX::Random(model.nq);
+      const VectorX v = 2.0 * VectorX::Random(model.nv);
+      const VectorX a = 5.0 * VectorX::Random(model.nv);
+      const VectorX& tau = rnea(model, ours, q, v, a, Vector3(0, 0, -9.81));
+      const std::vector<double> qpos = mjcfQpos(model, q);
+      for (int i = 0; i < m->nq; ++i) d->qpos[i] = qpos[static_cast<std::size_t>(i)];
+      // per joint: MuJoCo's dof address, our velocity index, and the expected generalized force
+      std::vector<double> expected(static_cast<std::size_t>(m->nv));
+      for (const Joint& j : model.joints) {
+        const int b = mj_name2id(m, mjOBJ_BODY, j.name.c_str());
+        ASSERT_GE(b, 1) << j.name;
+        const int dof = m->jnt_dofadr[m->body_jntadr[b]];
+        if (j.type == JointType::kFreeFlyer) {
+          const Matrix3 R = mannequin::math::expSO3(q.segment<3>(j.idx_q + 3));
+          const Vector3 w = v.segment<3>(j.idx_v), vb = v.segment<3>(j.idx_v + 3);
+          const Vector3 dw = a.segment<3>(j.idx_v), dvb = a.segment<3>(j.idx_v + 3);
+          const Vector3 pdot = R * vb, pddot = R * (dvb + w.cross(vb));
+          const Vector3 f = R * tau.segment<3>(j.idx_v + 3);
+          for (int k = 0; k < 3; ++k) {
+            d->qvel[dof + k] = pdot[k];
+            d->qvel[dof + 3 + k] = w[k];
+            d->qacc[dof + k] = pddot[k];
+            d->qacc[dof + 3 + k] = dw[k];
+            expected[static_cast<std::size_t>(dof + k)] = f[k];
+            expected[static_cast<std::size_t>(dof + 3 + k)] = tau[j.idx_v + k];
+          }
+        } else {
+          for (int k = 0; k < j.nv; ++k) {
+            d->qvel[dof + k] = v[j.idx_v + k];
+            d->qacc[dof + k] = a[j.idx_v + k];
+            expected[static_cast<std::size_t>(dof + k)] = tau[j.idx_v + k];
+          }
+        }
+      }
+      mj_fwdPosition(m, d);
+      mj_fwdVelocity(m, d);  // cvel and cdof_dot, which mj_rne reads
+      mj_rne(m, d, 1, res.data());
+      for (int i = 0; i < m->nv; ++i) {
+        const double e = expected[static_cast<std::size_t>(i)];
+        EXPECT_NEAR(res[static_cast<std::size_t>(i)], e, 1e-8 * (1.0 + std::abs(e)))
+            << "seed " << seed << " trial " << trial << " dof " << i;
       }
     }
     mj_deleteData(d);
