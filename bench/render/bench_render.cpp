@@ -169,13 +169,19 @@ BENCHMARK(BM_BuildScene)->Unit(benchmark::kMicrosecond);
 namespace fs = std::filesystem;
 
 // A child process (posix_spawn); stop() sends SIGTERM to a pid > 0 and waits with a deadline (SIGKILL at it).
+// Its standard output goes to the benchmark's standard error: the benchmark's own standard output carries
+// only its report (--benchmark_format=json, read by tools/perf-report).
 class Child {
  public:
   explicit Child(std::vector<std::string> args) {
     std::vector<char*> argv;
     for (std::string& a : args) argv.push_back(a.data());
     argv.push_back(nullptr);
-    if (::posix_spawnp(&pid_, argv[0], nullptr, nullptr, argv.data(), environ) != 0) pid_ = 0;
+    posix_spawn_file_actions_t actions;
+    ::posix_spawn_file_actions_init(&actions);
+    ::posix_spawn_file_actions_adddup2(&actions, STDERR_FILENO, STDOUT_FILENO);
+    if (::posix_spawnp(&pid_, argv[0], &actions, nullptr, argv.data(), environ) != 0) pid_ = 0;
+    ::posix_spawn_file_actions_destroy(&actions);
     if (pid_ <= 0) throw std::runtime_error("cannot start " + args[0]);
   }
   ~Child() { stop(10); }
