@@ -3,10 +3,13 @@
 // directory with core::findData, and a main that turns any error into a message on stderr and exit
 // code 2 — a benchmark never ends in std::terminate.
 #include <benchmark/benchmark.h>
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
 
 #include <cstdio>
 #include <exception>
 #include <initializer_list>
+#include <memory>
 #include <string>
 
 #include "mannequin/core/paths.hpp"
@@ -35,8 +38,12 @@ int guarded(const char* name, Body&& body) {
   return 2;
 }
 
-/// Google Benchmark's main body: 1 on an unknown flag, 0 after the run.
+/// Google Benchmark's main body: 1 on an unknown flag, 0 after the run. Standard output carries the report
+/// only (--benchmark_format=json is read by tools/perf-report): what the code under test logs (spdlog's
+/// default logger, e.g. a service run in-process) goes to standard error.
 inline int runSpecified(int argc, char** argv, benchmark::BenchmarkReporter* reporter = nullptr) {
+  spdlog::set_default_logger(
+      std::make_shared<spdlog::logger>("", std::make_shared<spdlog::sinks::stderr_color_sink_mt>()));
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 1;
   if (reporter != nullptr) {
