@@ -34,8 +34,8 @@ endif()
 
 # mannequin_use_pch(<target> test|tool)
 # The harness code (test executables: kind `test`; tools and service mains: kind `tool`) is compiled at -O1
-# (MANNEQUIN_TEST_CODE_FLAGS), where parsing the Eigen, GoogleTest, CLI11, spdlog, yaml-cpp and protobuf
-# headers is a large share of each source's compile time. With MANNEQUIN_PCH those headers
+# (MANNEQUIN_TEST_CODE_FLAGS), and each of its sources parses the Eigen, GoogleTest, CLI11, spdlog,
+# yaml-cpp and protobuf headers again. With MANNEQUIN_PCH those headers
 # (cmake/pch/<kind>.hpp) are parsed once per build tree, by the target mannequin_pch_<kind>, and every
 # harness target of that kind reuses the result (REUSE_FROM). A precompiled header is only valid with the
 # flags and definitions it was built with, so the host gets the harness code's flags and the consumers the
