@@ -158,6 +158,7 @@ TEST_F(SimulateTool, TheLeaningWorkerHoldsTheWholeMarginOnlyWithTheHandOnTheWall
       "k = d['kinetics']\nassert len(k) == 1 and k[0]['mannequin'] == 'operator', k\n"
       "k = k[0]\nassert abs(k['weight_n'] - 78.5 * 9.81) < 0.5, k\nassert k['samples'] >= 400, k\n"
       "assert abs(k['grf_mean_over_weight'] - 1.0) < 0.03, k\n"
+      "assert abs(d['grf_mean_over_weight'] - k['grf_mean_over_weight']) < 1e-12, d\n"
       "assert k['residual_force_mean_n'] < 0.1 * k['weight_n'], k\nprint('ok')");
   EXPECT_EQ(k_status, 0) << k_out << a.out;
   // a bad balance controller setting: exit 2 naming the file, line and field

@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <cstdio>
 #include <filesystem>
 #include <optional>
@@ -176,15 +177,26 @@ class RecordedCapture : public mocap::Source {
 
 }  // namespace
 
+double groundReactionOverWeight(const OfflineSummary& s) {
+  double force = 0, weight = 0;
+  for (const sim::MannequinKinetics& mk : s.kinetics) {
+    if (mk.summary.frames <= 0) continue;
+    force += mk.summary.grf_mean_over_weight * mk.summary.weight_n;
+    weight += mk.summary.weight_n;
+  }
+  return weight > 0 ? force / weight : std::numeric_limits<double>::quiet_NaN();
+}
+
 std::string summaryJsonMembers(const OfflineSummary& s) {
   const auto num = [](double v) { return std::isfinite(v) ? fmt::format("{:.17g}", v) : std::string("null"); };
   return fmt::format(
       "\"frames\": {}, \"steps\": {}, \"sim_time_s\": {}, \"wall_s\": {}, \"realtime_factor\": {}, \"nan_steps\": {}, "
       "\"lcp_failures\": {}, \"max_penetration_m\": {}, \"max_contacts\": {}, \"mean_contacts\": {}, "
-      "\"foot_contact_fraction\": {}, \"min_balance_distance_m\": {}, \"min_force_margin_n\": {}",
+      "\"foot_contact_fraction\": {}, \"min_balance_distance_m\": {}, \"min_force_margin_n\": {}, "
+      "\"grf_mean_over_weight\": {}",
       s.frames, s.steps, num(s.sim_time_s), num(s.wall_s), num(s.realtimeFactor()), s.nan_steps, s.lcp_failures,
       num(s.max_penetration_m), s.max_contacts, num(s.meanContacts()), num(s.footContactFraction()),
-      num(s.min_balance_distance_m), num(s.min_force_margin_n));
+      num(s.min_balance_distance_m), num(s.min_force_margin_n), num(groundReactionOverWeight(s)));
 }
 
 std::string kineticsJson(const sim::MannequinKinetics& mk) {

@@ -79,9 +79,15 @@ struct OfflineSummary : sim::RunTotals {
 /// The figures of a run that every summary carries (mannequin-simulate --json, mannequin-batch's
 /// summary.json), as JSON members without the braces: "frames", "steps", "sim_time_s", "wall_s",
 /// "realtime_factor", "nan_steps", "lcp_failures", "max_penetration_m", "max_contacts", "mean_contacts",
-/// "foot_contact_fraction", "min_balance_distance_m", "min_force_margin_n". Numbers with 17 significant
-/// digits (the same double prints the same text), null when not finite.
+/// "foot_contact_fraction", "min_balance_distance_m", "min_force_margin_n", "grf_mean_over_weight"
+/// (groundReactionOverWeight). Numbers with 17 significant digits (the same double prints the same text),
+/// null when not finite.
 std::string summaryJsonMembers(const OfflineSummary& s);
+
+/// The mean vertical contact force on every mannequin over their total weight: Σ_m grf_mean_m / Σ_m weight_m
+/// over the mannequins with kinetics samples (one mannequin: its kinetics' grf_mean_over_weight); NaN
+/// without any. Over a motion that starts and ends at rest, momentum balance wants 1.
+double groundReactionOverWeight(const OfflineSummary& s);
 
 /// One mannequin's kinetics as a JSON object: "mannequin", "samples", "weight_n", "grf_mean_over_weight",
 /// "residual_force_mean_n", "residual_force_peak_n", "residual_moment_peak_nm", "peak_external_force_n"
