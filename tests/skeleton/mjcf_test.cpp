@@ -249,6 +249,23 @@ mjModel* loadMujoco(const std::string& xml, std::string& error) {
   error = err;
   return m;
 }
+
+/// randomTree(seed, 15) and its MJCF loaded in MuJoCo with an mjData; m is nullptr (error says why) when
+/// MuJoCo refused it. Frees both however the test ends.
+struct MujocoTree {
+  explicit MujocoTree(unsigned seed)
+      : model(randomTree(seed, 15)), m(loadMujoco(toMjcf(model), error)), d(m ? mj_makeData(m) : nullptr) {}
+  ~MujocoTree() {
+    if (d) mj_deleteData(d);
+    if (m) mj_deleteModel(m);
+  }
+  MujocoTree(const MujocoTree&) = delete;
+  MujocoTree& operator=(const MujocoTree&) = delete;
+  Model model;
+  std::string error;
+  mjModel* m;
+  mjData* d;
+};
 }  // namespace
 
 TEST(MjcfMujoco, LoadsWithOurSizesMassAndForwardKinematics) {
@@ -302,11 +319,11 @@ TEST(MjcfMujoco, LoadsWithOurSizesMassAndForwardKinematics) {
 TEST(MjcfMujoco, RandomTreeForwardKinematicsMatchesAtRandomConfigurations) {
   // rotated placements, random axes, a tree whose index order is not depth first: mjcfQpos's order
   for (unsigned seed : {3u, 11u}) {
-    const Model model = randomTree(seed, 15);
-    std::string error;
-    mjModel* m = loadMujoco(toMjcf(model), error);
-    ASSERT_NE(m, nullptr) << error;
-    mjData* d = mj_makeData(m);
+    const MujocoTree tree(seed);
+    ASSERT_NE(tree.m, nullptr) << tree.error;
+    const Model& model = tree.model;
+    mjModel* m = tree.m;
+    mjData* d = tree.d;
     Data ours(model);
     std::srand(seed);
     for (int trial = 0; trial < 5; ++trial) {
@@ -325,8 +342,6 @@ TEST(MjcfMujoco, RandomTreeForwardKinematicsMatchesAtRandomConfigurations) {
         }
       }
     }
-    mj_deleteData(d);
-    mj_deleteModel(m);
   }
 }
 #endif
@@ -339,12 +354,12 @@ TEST(MjcfMujoco, InverseDynamicsMatchesMujocosRneAtRandomStates) {
   // body twist, MuJoCo's free joint (ṗ in the world, ω_b), so with R the root's orientation
   //   qvel = (R v_b, ω_b),  qacc = (R (v̇_b + ω_b × v_b), ω̇_b),  and its force (R f_b, n_b) for τ = (n_b, f_b).
   for (unsigned seed : {3u, 11u}) {
-    const Model model = randomTree(seed, 15);
-    std::string error;
-    mjModel* m = loadMujoco(toMjcf(model), error);
-    ASSERT_NE(m, nullptr) << error;
+    const MujocoTree tree(seed);
+    ASSERT_NE(tree.m, nullptr) << tree.error;
+    const Model& model = tree.model;
+    mjModel* m = tree.m;
+    mjData* d = tree.d;
     ASSERT_EQ(m->nv, model.nv);
-    mjData* d = mj_makeData(m);
     Data ours(model);
     std::srand(seed);
     std::vector<mjtNum> res(static_cast<std::size_t>(m->nv));
@@ -392,8 +407,6 @@ TEST(MjcfMujoco, InverseDynamicsMatchesMujocosRneAtRandomStates) {
             << "seed " << seed << " trial " << trial << " dof " << i;
       }
     }
-    mj_deleteData(d);
-    mj_deleteModel(m);
   }
 }
 #endif
