@@ -5,13 +5,14 @@
 namespace mannequin::sim {
 
 void World::updateBalanceController() {
-  Physics& P = *physics_;
-  const PhysicsConfig& pc = config_.physics;
+  PhysicsData& P = *data_->physics;
+  const PhysicsConfig& pc = model_.config.physics;
   const BalanceControllerConfig& bc = pc.balance_controller;
-  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
-    Mannequin& man = *mannequins_[m];
-    Physics::BalanceLoop& L = P.balance_loops[m];
-    MannequinDiagnostics& md = mannequin_diagnostics_[m];
+  for (std::size_t m = 0; m < data_->mannequins.size(); ++m) {
+    const skeleton::Model& model = model_.mannequins[m].model;
+    MannequinData& man = data_->mannequins[m];
+    PhysicsData::BalanceLoop& L = P.balance_loops[m];
+    MannequinDiagnostics& md = data_->mannequin_diagnostics[m];
     if (!man.calibrated) continue;
     const skeleton::Data& d = man.stepper->data();  // the simulated mannequin's kinematics at q_{k+1}
     // Algorithm 5 iterates on the controller's own configuration q_b (from the simulated q at the
@@ -19,13 +20,13 @@ void World::updateBalanceController() {
     // of the couplings under gravity the next solve's starting point, and the body would sink.
     if (!L.driving) {
       L.q_b = man.stepper->q();
-      skeleton::forwardKinematics(man.model, L.data, L.q_b);
+      skeleton::forwardKinematics(model, L.data, L.q_b);
       L.fraction = 0.0;
     }
     balance::VariationalBalanceProblem& bp = L.problem;
     // the touching contacts with the static scene, as in the force margins, on the joints of their segments
     bp.contacts.clear();
-    for (const ContactReport& r : contacts_) {
+    for (const ContactReport& r : data_->contacts) {
       const int ma = P.body_mannequin[static_cast<std::size_t>(r.body_a)], mb = P.body_mannequin[static_cast<std::size_t>(r.body_b)];
       const bool on_a = ma == static_cast<int>(m), on_b = mb == static_cast<int>(m);
       if (on_a == on_b) continue;
@@ -62,7 +63,7 @@ void World::updateBalanceController() {
     for (std::size_t i = 0; i < man.frames.size(); ++i) {
       if (L.taken[i] || man.weights[i] <= 0) continue;
       const int fi = man.frames[i].frame_index;
-      const int joint = man.model.frames[static_cast<std::size_t>(fi)].joint;
+      const int joint = model.frames[static_cast<std::size_t>(fi)].joint;
       bool held = false;
       for (const balance::HeldBody& h : bp.held) held = held || h.joint == joint;
       if (!held) bp.tasks.push_back({fi, man.frames[i].target.p});
@@ -75,7 +76,7 @@ void World::updateBalanceController() {
     bp.com_margins.clear();
     bp.margins_at_com = true;  // each push held at the posture's own CoM (what forceMargin measures)
     // the internal control (4.1): back towards the calibrated posture where nothing else decides
-    control::differenceInPlace(man.model, L.q_b, man.q_posture, bp.dq_desired);
+    control::differenceInPlace(model, L.q_b, man.q_posture, bp.dq_desired);
     bp.dq_desired *= bc.posture_gain;
     md.balance_contacts = static_cast<int>(bp.contacts.size());
     if (bp.contacts.empty()) {
@@ -95,7 +96,7 @@ void World::updateBalanceController() {
     // one small step (|δq| ≤ max_step), so each solve asks for a fraction s of them — 5 % more than
     // the last solve held, else what it held, 20 % less, none — and the fraction grows to 1 as the body
     // moves (MannequinDiagnostics::balance_margin_fraction). Infeasible even with none: reported as such.
-    const math::Vector3 com_b = skeleton::centerOfMass(man.model, L.data);  // the controller's CoM, at q_b
+    const math::Vector3 com_b = skeleton::centerOfMass(model, L.data);  // the controller's CoM, at q_b
     const double last = L.fraction;
     double tries[4] = {std::min(1.0, last + 0.05), last, std::max(0.0, last - 0.2), 0.0};
     const int ntries = bc.force_margins.empty() ? 1 : 4;
@@ -129,8 +130,8 @@ void World::updateBalanceController() {
     md.balance_status = res.status;
     md.balance_margin_fraction = res.status == balance::BalanceStatus::kSolved ? L.fraction : 0.0;
     if (res.status == balance::BalanceStatus::kSolved) {
-      L.q_b = skeleton::integrate(man.model, L.q_b, res.dq);
-      skeleton::forwardKinematics(man.model, L.data, L.q_b);
+      L.q_b = skeleton::integrate(model, L.q_b, res.dq);
+      skeleton::forwardKinematics(model, L.data, L.q_b);
       md.balance_com = res.com;
       L.driving = true;
       man.stepper->setPosture(L.q_b);
@@ -145,10 +146,10 @@ void World::updateBalanceController() {
 
 void World::applyBalanceTargets(std::size_t m) {
   // the frames the balance controller took over: their poses at q_b, held (V_d = 0)
-  const Physics::BalanceLoop& L = physics_->balance_loops[m];
+  const PhysicsData::BalanceLoop& L = data_->physics->balance_loops[m];
   if (!L.driving) return;
-  Mannequin& man = *mannequins_[m];
-  for (const int i : L.frames) {
+  MannequinData& man = data_->mannequins[m];
+  for (const int i : model_.mannequins[m].balance_frames) {
     DrivenFrame& st = man.frames[static_cast<std::size_t>(i)];
     st.target = L.data.oMf[static_cast<std::size_t>(st.frame_index)];
     man.stepper->setTarget(i, st.target, math::Vector6::Zero(), man.weights[static_cast<std::size_t>(i)]);
@@ -156,19 +157,19 @@ void World::applyBalanceTargets(std::size_t m) {
 }
 
 void World::updateForceMargins() {
-  Physics& P = *physics_;
-  const PhysicsConfig& pc = config_.physics;
+  PhysicsData& P = *data_->physics;
+  const PhysicsConfig& pc = model_.config.physics;
   static const std::vector<math::Vector3> kHorizontal = {{1, 0, 0}, {-1, 0, 0}, {0, 1, 0}, {0, -1, 0}};
-  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
-    MannequinDiagnostics& md = mannequin_diagnostics_[m];
-    if (!mannequins_[m]->calibrated) {
+  for (std::size_t m = 0; m < data_->mannequins.size(); ++m) {
+    MannequinDiagnostics& md = data_->mannequin_diagnostics[m];
+    if (!data_->mannequins[m].calibrated) {
       md.force_margin_n = std::numeric_limits<double>::quiet_NaN();
       md.force_margin_contacts = 0;
       continue;
     }
     balance::StaticBalanceProblem& bp = P.margin_problem;
     bp.contacts.clear();
-    for (const ContactReport& r : contacts_) {
+    for (const ContactReport& r : data_->contacts) {
       const int ma = P.body_mannequin[static_cast<std::size_t>(r.body_a)], mb = P.body_mannequin[static_cast<std::size_t>(r.body_b)];
       const bool on_a = ma == static_cast<int>(m), on_b = mb == static_cast<int>(m);
       if (on_a == on_b) continue;  // not this mannequin's, or a self contact
@@ -183,7 +184,7 @@ void World::updateForceMargins() {
       md.force_margin_n = 0.0;  // nothing holds it
       continue;
     }
-    bp.mass = mannequins_[m]->model.totalMass();
+    bp.mass = model_.mannequins[m].model.totalMass();
     bp.gravity = pc.gravity;
     bp.fix_com = true;
     bp.desired_com = md.com;
@@ -196,11 +197,11 @@ void World::updateForceMargins() {
 void World::updateSupport() {
   // each mannequin's support: the floor-side witness points of its feet's floor contacts within the
   // tolerance (the contact set of the last query, at the segment poses of that query)
-  Physics& P = *physics_;
+  PhysicsData& P = *data_->physics;
   for (auto& sp : P.support) sp.clear();
   if (P.floor_body >= 0)
     for (const collision::Contact& c : P.set.contacts) {
-      if (c.distance > config_.physics.foot_contact_tolerance) continue;
+      if (c.distance > model_.config.physics.foot_contact_tolerance) continue;
       const bool a_floor = c.body_a == P.floor_body, b_floor = c.body_b == P.floor_body;
       if (a_floor == b_floor) continue;
       const int foot = a_floor ? c.body_b : c.body_a;
@@ -210,9 +211,9 @@ void World::updateSupport() {
       if (sp.size() == sp.capacity()) continue;  // beyond max_points: the hull of the first ones
       sp.push_back(P.cw.bodyPose(foot).act(a_floor ? c.point_b : c.point_a));
     }
-  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
+  for (std::size_t m = 0; m < data_->mannequins.size(); ++m) {
     P.balance[m]->setSupport(P.support[m]);
-    if (!config_.physics.balance_rows) P.balance[m]->evaluate();  // the distance without the row
+    if (!model_.config.physics.balance_rows) P.balance[m]->evaluate();  // the distance without the row
   }
 }
 

@@ -12,12 +12,12 @@ bool finiteSE3(const math::SE3& T) {
 
 WorldCheckpoint World::checkpoint() const {
   WorldCheckpoint c;
-  c.step = steps_;
-  for (const auto& mp : mannequins_) {
-    const Mannequin& m = *mp;
+  c.step = data_->steps;
+  for (std::size_t k = 0; k < data_->mannequins.size(); ++k) {
+    const MannequinData& m = data_->mannequins[k];
     MannequinCheckpoint mc;
-    mc.name = m.name;
-    mc.model = m.model.name;
+    mc.name = model_.mannequins[k].name;
+    mc.model = model_.mannequins[k].model.name;
     mc.q = m.stepper->q();
     mc.calibrated = m.calibrated;
     if (m.calibrated) {
@@ -37,25 +37,27 @@ WorldCheckpoint World::checkpoint() const {
 std::vector<std::string> World::restore(const WorldCheckpoint& c) {
   // everything checked first: a refused checkpoint leaves the World as it was
   const auto fail = [](const std::string& what) { throw std::invalid_argument("sim: checkpoint: " + what); };
-  if (c.mannequins.size() != mannequins_.size()) {
+  const std::size_t nm = data_->mannequins.size();
+  if (c.mannequins.size() != nm) {
     std::string names;
     for (const MannequinCheckpoint& mc : c.mannequins) names += (names.empty() ? "" : ", ") + mc.name;
     fail("it has " + std::to_string(c.mannequins.size()) + " mannequin(s) (" + names + "), the World " +
-         std::to_string(mannequins_.size()));
+         std::to_string(nm));
   }
-  std::vector<const MannequinCheckpoint*> of(mannequins_.size(), nullptr);
-  for (std::size_t k = 0; k < mannequins_.size(); ++k) {
-    const Mannequin& m = *mannequins_[k];
+  std::vector<const MannequinCheckpoint*> of(nm, nullptr);
+  for (std::size_t k = 0; k < nm; ++k) {
+    const MannequinModel& mm = model_.mannequins[k];
+    const MannequinData& m = data_->mannequins[k];
     for (const MannequinCheckpoint& mc : c.mannequins)
-      if (mc.name == m.name) of[k] = &mc;
-    if (of[k] == nullptr) fail("no mannequin '" + m.name + "'");
+      if (mc.name == mm.name) of[k] = &mc;
+    if (of[k] == nullptr) fail("no mannequin '" + mm.name + "'");
     const MannequinCheckpoint& mc = *of[k];
-    const std::string who = "mannequin '" + m.name + "': ";
-    if (mc.model != m.model.name) fail(who + "model '" + mc.model + "', the World's is '" + m.model.name + "'");
-    if (mc.q.size() != m.model.nq) fail(who + "q has " + std::to_string(mc.q.size()) + " coordinates, the model " + std::to_string(m.model.nq));
+    const std::string who = "mannequin '" + mm.name + "': ";
+    if (mc.model != mm.model.name) fail(who + "model '" + mc.model + "', the World's is '" + mm.model.name + "'");
+    if (mc.q.size() != mm.model.nq) fail(who + "q has " + std::to_string(mc.q.size()) + " coordinates, the model " + std::to_string(mm.model.nq));
     if (!mc.q.allFinite()) fail(who + "q is not finite");
     if (!mc.calibrated) continue;
-    if (mc.q_posture.size() != m.model.nq || !mc.q_posture.allFinite()) fail(who + "the posture target q_c is not " + std::to_string(m.model.nq) + " finite numbers");
+    if (mc.q_posture.size() != mm.model.nq || !mc.q_posture.allFinite()) fail(who + "the posture target q_c is not " + std::to_string(mm.model.nq) + " finite numbers");
     if (mc.frames.size() != m.frames.size()) fail(who + std::to_string(mc.frames.size()) + " driven frames, the World " + std::to_string(m.frames.size()));
     for (const DrivenFrame& st : m.frames) {
       const MannequinCheckpoint::Frame* f = nullptr;
@@ -81,9 +83,9 @@ std::vector<std::string> World::restore(const WorldCheckpoint& c) {
   }
   // apply
   std::vector<std::string> notes;
-  steps_ = c.step;
-  for (std::size_t k = 0; k < mannequins_.size(); ++k) {
-    Mannequin& m = *mannequins_[k];
+  data_->steps = c.step;
+  for (std::size_t k = 0; k < nm; ++k) {
+    MannequinData& m = data_->mannequins[k];
     const MannequinCheckpoint& mc = *of[k];
     m.stepper->reset(mc.q);
     std::fill(m.have_previous.begin(), m.have_previous.end(), false);
@@ -110,11 +112,11 @@ std::vector<std::string> World::restore(const WorldCheckpoint& c) {
       m.frames[i].weight = m.weights[i];
       if (!mc.calibrated) m.frames[i].target = m.frames[i].actual;
     }
-    if (physics_) {
-      physics_->cw.setMannequinPlaced(physics_->cw_mannequin[k], mc.calibrated);
-      if (!physics_->balance_loops.empty()) {
-        if (physics_->balance_loops[k].driving) notes.push_back("mannequin '" + m.name + "': the balance controller starts again from q");
-        physics_->balance_loops[k].driving = false;
+    if (data_->physics) {
+      data_->physics->cw.setMannequinPlaced(data_->physics->cw_mannequin[k], mc.calibrated);
+      if (!data_->physics->balance_loops.empty()) {
+        if (data_->physics->balance_loops[k].driving) notes.push_back("mannequin '" + model_.mannequins[k].name + "': the balance controller starts again from q");
+        data_->physics->balance_loops[k].driving = false;
       }
     }
   }

@@ -34,14 +34,14 @@ double worstLimitExcess(const skeleton::Model& model, const skeleton::VectorX& q
 }
 
 void World::computeDiagnostics() {
-  const Physics& P = *physics_;
+  const PhysicsData& P = *data_->physics;
   const auto& cts = P.contacts->contacts();
   const auto& states = P.contacts->states();
-  contacts_.clear();
-  diagnostics_.contacts = 0;
-  diagnostics_.active_contacts = 0;
-  diagnostics_.max_penetration_m = P.contacts->maxPenetration();
-  for (MannequinDiagnostics& md : mannequin_diagnostics_) {
+  data_->contacts.clear();
+  data_->diagnostics.contacts = 0;
+  data_->diagnostics.active_contacts = 0;
+  data_->diagnostics.max_penetration_m = P.contacts->maxPenetration();
+  for (MannequinDiagnostics& md : data_->mannequin_diagnostics) {
     md.contacts = 0;
     md.foot_contact = false;
     md.sole_height_m = std::numeric_limits<double>::infinity();
@@ -50,8 +50,8 @@ void World::computeDiagnostics() {
     const collision::Contact& c = cts[i];
     const auto& st = states[i];
     if (st.row < 0) continue;
-    ++diagnostics_.contacts;
-    if (st.normal_force > 0) ++diagnostics_.active_contacts;
+    ++data_->diagnostics.contacts;
+    if (st.normal_force > 0) ++data_->diagnostics.active_contacts;
     ContactReport r;
     r.body_a = c.body_a;
     r.body_b = c.body_b;
@@ -60,11 +60,11 @@ void World::computeDiagnostics() {
     r.distance = st.distance;
     r.normal_force = st.normal_force;
     r.friction_force = st.friction_force;
-    contacts_.push_back(r);
+    data_->contacts.push_back(r);
     for (const int b : {c.body_a, c.body_b}) {
       const int m = P.body_mannequin[static_cast<std::size_t>(b)];
       if (m < 0) continue;
-      MannequinDiagnostics& md = mannequin_diagnostics_[static_cast<std::size_t>(m)];
+      MannequinDiagnostics& md = data_->mannequin_diagnostics[static_cast<std::size_t>(m)];
       ++md.contacts;
       const int other = b == c.body_a ? c.body_b : c.body_a;
       if (P.body_is_foot[static_cast<std::size_t>(b)] && other == P.floor_body) {
@@ -72,15 +72,15 @@ void World::computeDiagnostics() {
         const double gap = st.distance + P.cw.margin(c.body_a) + P.cw.margin(c.body_b);
         md.sole_height_m = std::min(md.sole_height_m, gap);
         // touching: pressed, or its margin shell within 1 mm of the floor's
-        if (st.normal_force > 0 || st.distance <= config_.physics.foot_contact_tolerance) md.foot_contact = true;
+        if (st.normal_force > 0 || st.distance <= model_.config.physics.foot_contact_tolerance) md.foot_contact = true;
       }
     }
   }
-  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
-    MannequinDiagnostics& md = mannequin_diagnostics_[m];
+  for (std::size_t m = 0; m < data_->mannequins.size(); ++m) {
+    MannequinDiagnostics& md = data_->mannequin_diagnostics[m];
     // no foot–floor pair in range: the soles are at least the activation distance (plus margins) up
-    if (!std::isfinite(md.sole_height_m)) md.sole_height_m = config_.physics.activation_distance;
-    md.worst_joint_limit_excess_rad = worstLimitExcess(mannequins_[m]->model, mannequins_[m]->controller->q());
+    if (!std::isfinite(md.sole_height_m)) md.sole_height_m = model_.config.physics.activation_distance;
+    md.worst_joint_limit_excess_rad = worstLimitExcess(model_.mannequins[m].model, data_->mannequins[m].controller->q());
     // balance at q_k (the support and CoM the step's row saw)
     const constraints::BalanceRows::State& bs = P.balance[m]->state();
     md.balance_distance_m = bs.distance.polygon_m;
@@ -90,8 +90,7 @@ void World::computeDiagnostics() {
 }
 
 void World::updateFrameErrors() {
-  for (auto& mp : mannequins_) {
-    Mannequin& m = *mp;
+  for (MannequinData& m : data_->mannequins) {
     const skeleton::Data& d = m.stepper->data();
     for (std::size_t i = 0; i < m.frames.size(); ++i) {
       DrivenFrame& st = m.frames[i];

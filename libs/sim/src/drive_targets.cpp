@@ -4,16 +4,17 @@
 
 namespace mannequin::sim {
 
-math::Vector6 World::targetTwist(Mannequin& m, std::size_t i, double dt) const {
+math::Vector6 World::targetTwist(std::size_t index, std::size_t i, double dt) {
+  MannequinData& m = data_->mannequins[index];
   const math::SE3& T = m.frames[i].target;
   math::Vector6 V = math::Vector6::Zero();
-  if (config_.target_twist && m.have_previous[i]) {
+  if (model_.config.target_twist && m.have_previous[i]) {
     const math::SE3& P = m.previous_targets[i];
     V.head<3>() = math::logSO3(P.R.transpose() * T.R) / dt;
     V.tail<3>() = T.R.transpose() * (T.p - P.p) / dt;
     // a jump (re-tracked body, re-anchored clock) is not a motion to feed forward
-    if (!V.allFinite() || V.tail<3>().norm() > config_.max_target_speed ||
-        0.3 * V.head<3>().norm() > config_.max_target_speed)
+    if (!V.allFinite() || V.tail<3>().norm() > model_.config.max_target_speed ||
+        0.3 * V.head<3>().norm() > model_.config.max_target_speed)
       V.setZero();
   }
   m.previous_targets[i] = T;
@@ -21,14 +22,16 @@ math::Vector6 World::targetTwist(Mannequin& m, std::size_t i, double dt) const {
   return V;
 }
 
-void World::driveTargets(Mannequin& m, double dt) {
-  const Source& src = *sources_[static_cast<std::size_t>(m.source)];
+void World::driveTargets(std::size_t index, double dt) {
+  MannequinData& m = data_->mannequins[index];
+  const int k_src = model_.mannequins[index].source;
+  const SourceData& src = data_->sources[static_cast<std::size_t>(k_src)];
   if (m.calibrated && src.anchored) {
     // restored (World::restore) and holding its targets until now: the first live targets catch up from the
     // held ones, as after a stream gap (the actor may have moved while the sim was down)
     const bool was_holding = m.holding_restored;
     m.holding_restored = false;
-    const std::int64_t t = captureTimeNs(src.name);
+    const std::int64_t t = captureTimeNs(model_.sources[static_cast<std::size_t>(k_src)]);
     for (std::size_t i = 0; i < m.frames.size(); ++i) {
       DrivenFrame& st = m.frames[i];
       const math::SE3 held = st.target;
@@ -39,14 +42,14 @@ void World::driveTargets(Mannequin& m, double dt) {
       } else {
         const double since = static_cast<double>(t - s.last_tracked_ns) * 1e-9;
         if (s.ever_tracked) st.target = s.pose * st.offset;  // hold the last tracked pose
-        goal = since <= config_.occlusion_hold
+        goal = since <= model_.config.occlusion_hold
                    ? 1.0
-                   : std::max(0.0, 1.0 - (since - config_.occlusion_hold) / std::max(config_.occlusion_blend, 1e-9));
+                   : std::max(0.0, 1.0 - (since - model_.config.occlusion_hold) / std::max(model_.config.occlusion_blend, 1e-9));
       }
-      if (st.tracked && !s.tracked) ++glitches_.occlusions;
+      if (st.tracked && !s.tracked) ++data_->glitches.occlusions;
       st.tracked = s.tracked;
       // weights move towards their goal at 1/blend per second (back in after an occlusion: no jump)
-      const double rate = dt / std::max(config_.occlusion_blend, 1e-9);
+      const double rate = dt / std::max(model_.config.occlusion_blend, 1e-9);
       double& w = m.weights[i];
       w = goal > w ? std::min(goal, w + rate) : goal;
       // back after a stream gap (or re-anchored) the body may be far from the target: the target keeps the offset it
@@ -68,8 +71,8 @@ void World::driveTargets(Mannequin& m, double dt) {
       }
       // a target moving faster than max_target_speed (m/s) jumped (a marker swap, a re-tracked body, a
       // re-anchored clock): counted (its twist is not fed forward, targetTwist)
-      if (m.have_previous[i] && (st.target.p - m.previous_targets[i].p).norm() > config_.max_target_speed * dt) ++glitches_.target_jumps;
-      m.stepper->setTarget(static_cast<int>(i), st.target, targetTwist(m, i, dt), w);
+      if (m.have_previous[i] && (st.target.p - m.previous_targets[i].p).norm() > model_.config.max_target_speed * dt) ++data_->glitches.target_jumps;
+      m.stepper->setTarget(static_cast<int>(i), st.target, targetTwist(index, i, dt), w);
     }
   } else {
     // not calibrated: no target; restored (World::restore) and waiting for its source's first frame:

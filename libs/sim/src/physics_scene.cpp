@@ -1,73 +1,32 @@
-// The physics scene of a World (PhysicsConfig): its assembly from the config (collision world,
-// body bindings, μ table, row producers, balance loops) and its objects, grasps and guides.
+// The physics scene of a World: its runtime (PhysicsData: collision world, body bindings, row
+// producers, balance loops) built from the WorldModel's PhysicsModel, and its objects, grasps and guides.
 #include "world_state.hpp"
 
 namespace mannequin::sim {
 
-namespace {
-/// Segment pairs of a mannequin already within the activation distance of each other (margins
-/// included) in its standing configuration — thighs side by side, arms along the trunk. They are
-/// excluded from its self contacts: at calibration they would start inside each other's margins and
-/// the contact rows would fight the posture for the whole session (docs/constraints.md).
-std::vector<std::pair<std::string, std::string>> touchingWhenStanding(const skeleton::Model& model,
-                                                                      const collision::MannequinOptions& options,
-                                                                      double activation) {
-  collision::WorldOptions wo;
-  wo.activation_distance = activation;
-  collision::CollisionWorld cw(wo);
-  const int mi = cw.addMannequin(model, options);
-  skeleton::Data d(model);
-  skeleton::forwardKinematics(model, d, skeleton::standingConfiguration(model));
-  cw.updateMannequin(mi, d);
-  collision::ContactSet set;
-  cw.query(0, set);
-  std::vector<std::pair<std::string, std::string>> pairs = options.exclude_pairs;
-  for (const collision::Contact& c : set.contacts) {
-    std::string a = cw.bodyName(c.body_a), b = cw.bodyName(c.body_b);
-    a = a.substr(a.find('/') + 1);
-    b = b.substr(b.find('/') + 1);
-    if (std::find(pairs.begin(), pairs.end(), std::make_pair(a, b)) == pairs.end()) pairs.emplace_back(a, b);
-  }
-
-  return pairs;
-}
-}  // namespace
-
 void World::buildPhysics() {
-  const PhysicsConfig& pc = config_.physics;
-  if (!(pc.segment_margin >= 0) || !std::isfinite(pc.segment_margin))
-    throw std::invalid_argument("sim: physics.segment_margin must be finite and >= 0");
-  if (pc.query_period_steps < 1) throw std::invalid_argument("sim: physics.query_period_steps must be >= 1");
-  if (!(pc.activation_distance > 0) || !std::isfinite(pc.activation_distance))
-    throw std::invalid_argument("sim: physics.activation_distance must be finite and > 0");
+  const PhysicsConfig& pc = model_.config.physics;
+  const PhysicsModel& pm = *model_.physics;
+  const collision::SceneSpec& scene = pm.scene;
+  std::vector<MannequinData>& mannequins = data_->mannequins;
   collision::WorldOptions wo;
   wo.activation_distance = pc.activation_distance;
-  physics_ = std::make_unique<Physics>(wo);
-  Physics& P = *physics_;
-  collision::SceneSpec scene = pc.scene;
-  scene.activation_distance = pc.activation_distance;  // the physics' candidates, not the scene file's display range
+  data_->physics = std::make_unique<PhysicsData>(wo);
+  PhysicsData& P = *data_->physics;
   P.cw.addScene(scene);
   std::vector<constraints::ConstrainedSystem*> systems;
-  for (auto& mp : mannequins_) {
-    ControllerStepper* cs = mp->controller;
-    if (cs == nullptr)
-      throw std::invalid_argument("sim: mannequin '" + mp->name + "': physics needs the controller stepper (stepper: controller)");
-    collision::MannequinOptions mo;
-    mo.name = mp->name;
-    mo.margin = pc.segment_margin;
-    mo.self_collision = pc.self_collision;
-    mo.exclude_pairs = touchingWhenStanding(mp->model, mo, pc.activation_distance);
-    P.cw_mannequin.push_back(P.cw.addMannequin(mp->model, mo));
+  for (std::size_t m = 0; m < mannequins.size(); ++m) {
+    ControllerStepper* cs = mannequins[m].controller;  // set: buildWorldModel checked every mannequin has a controller
+    const skeleton::Model& model = model_.mannequins[m].model;
+    P.cw_mannequin.push_back(P.cw.addMannequin(model, pm.mannequin_options[m]));
     // not yet calibrated: no place of its own (it stands where it was built, where the others may
     // stand too), it touches only the static scene and itself
     P.cw.setMannequinPlaced(P.cw_mannequin.back(), false);
     P.systems.push_back(std::make_unique<MannequinSystem>(cs->controller()));
-    P.frames.push_back(std::make_unique<constraints::MannequinFrames>(mp->model, cs->controller().data()));
+    P.frames.push_back(std::make_unique<constraints::MannequinFrames>(model, cs->controller().data()));
     systems.push_back(P.systems.back().get());
   }
   // the scene's movable bodies with a mass: rigid objects, systems after the mannequins
-  if (!(pc.object_time_constant > 0) || !std::isfinite(pc.object_time_constant))
-    throw std::invalid_argument("sim: physics.object_time_constant must be finite and > 0");
   std::vector<int> object_spec;
   P.objects = makeObjects(scene, &object_spec, pc.object_time_constant);
   for (std::size_t i = 0; i < P.objects.size(); ++i) {
@@ -77,14 +36,7 @@ void World::buildPhysics() {
     P.cw.setBodyPose(b, P.objects[i].pose());
     systems.push_back(&P.objects[i]);
   }
-  // materials: the scene's, then the segments'; μ from the scene's table (default_mu elsewhere)
-  std::vector<std::string> materials{scene.default_material};
-  const auto material = [&](const std::string& name) {
-    for (std::size_t i = 0; i < materials.size(); ++i)
-      if (materials[i] == name) return static_cast<int>(i);
-    materials.push_back(name);
-    return static_cast<int>(materials.size()) - 1;
-  };
+  // the bodies' bindings to their systems, materials (PhysicsModel::materials) and margins
   const int n = P.cw.bodyCount();
   std::vector<constraints::BodyBinding> bindings(static_cast<std::size_t>(n));
   P.body_mannequin.assign(static_cast<std::size_t>(n), -1);
@@ -98,9 +50,9 @@ void World::buildPhysics() {
     const std::string& bname = P.cw.bodyName(b);
     if (bname == "scene/floor") P.floor_body = b;
     for (const collision::BodySpec& bs : scene.bodies)
-      if ("scene/" + bs.name == bname) bb.material = material(bs.material);
+      if ("scene/" + bs.name == bname) bb.material = pm.material(bs.material);
   }
-  const int nm = static_cast<int>(mannequins_.size());
+  const int nm = static_cast<int>(mannequins.size());
   for (std::size_t i = 0; i < P.objects.size(); ++i) {
     const int b = P.object_body[i];
     constraints::BodyBinding& bb = bindings[static_cast<std::size_t>(b)];
@@ -109,9 +61,8 @@ void World::buildPhysics() {
     bb.local = 0;
     P.body_object[static_cast<std::size_t>(b)] = static_cast<int>(i);
   }
-  const int seg_material = material(pc.segment_material);
-  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
-    const skeleton::Model& model = mannequins_[m]->model;
+  for (std::size_t m = 0; m < mannequins.size(); ++m) {
+    const skeleton::Model& model = model_.mannequins[m].model;
     for (std::size_t sgi = 0; sgi < model.segments.size(); ++sgi) {
       const int b = P.cw.segmentBody(P.cw_mannequin[m], static_cast<int>(sgi));
       if (b < 0) continue;
@@ -119,27 +70,19 @@ void World::buildPhysics() {
       bb.system = static_cast<int>(m);
       bb.frames = P.frames[m].get();
       bb.local = model.segments[sgi].joint;
-      bb.material = seg_material;
+      bb.material = pm.segment_material;
       P.body_mannequin[static_cast<std::size_t>(b)] = static_cast<int>(m);
       const std::string& sn = model.segments[sgi].name;
       P.body_is_foot[static_cast<std::size_t>(b)] = sn.rfind("foot", 0) == 0 || sn.rfind("toes", 0) == 0;
       P.body_joint[static_cast<std::size_t>(b)] = model.segments[sgi].joint;
     }
   }
-  constraints::ContactOptions co = pc.contacts;
-  const int n_materials = static_cast<int>(materials.size());
-  co.mu = Eigen::MatrixXd::Constant(n_materials, n_materials, scene.default_mu);
-  for (const collision::FrictionPair& fp : scene.friction) {
-    const int a = material(fp.a), b = material(fp.b);
-    if (a >= co.mu.rows() || b >= co.mu.rows()) continue;  // a material no body uses
-    co.mu(a, b) = co.mu(b, a) = fp.mu;
-  }
-  P.contacts = std::make_unique<constraints::ContactRows>(std::move(bindings), co);
+  P.contacts = std::make_unique<constraints::ContactRows>(std::move(bindings), pm.contacts);
   P.solver = std::make_unique<constraints::ConstraintSolver>(systems, pc.solver);
   // the joint limits (and swing/twist) in the same LCP as the contacts: each sees the other's force
-  if (config_.joint_limits)
-    for (std::size_t m = 0; m < mannequins_.size(); ++m) {
-      P.limits.push_back(std::make_unique<constraints::JointLimitRows>(*P.systems[m], static_cast<int>(m), *config_.joint_limits));
+  if (model_.config.joint_limits)
+    for (std::size_t m = 0; m < mannequins.size(); ++m) {
+      P.limits.push_back(std::make_unique<constraints::JointLimitRows>(*P.systems[m], static_cast<int>(m), *model_.config.joint_limits));
       P.solver->addProducer(P.limits.back().get());
     }
   P.solver->addProducer(P.contacts.get());
@@ -153,7 +96,7 @@ void World::buildPhysics() {
     all_objects.push_back(&P.objects[i]);
     object_systems.push_back(nm + static_cast<int>(i));
   }
-  for (const auto& mp : mannequins_) max_nv = std::max(max_nv, mp->model.nv);
+  for (const MannequinModel& mm : model_.mannequins) max_nv = std::max(max_nv, mm.model.nv);
   if (!hinged.empty()) {
     P.hinges = std::make_unique<HingeLimitRows>(std::move(hinged));
     P.solver->addProducer(P.hinges.get());
@@ -166,9 +109,9 @@ void World::buildPhysics() {
     P.grasp_records.assign(8, {});  // GraspRows' default max_grasps
   }
   // balance: the support region of each mannequin's feet, its CoM distance, and (balance_rows) its row
-  for (std::size_t m = 0; m < mannequins_.size(); ++m) {
-    ControllerStepper& cs = *mannequins_[m]->controller;
-    P.balance.push_back(std::make_unique<constraints::BalanceRows>(static_cast<int>(m), mannequins_[m]->model,
+  for (std::size_t m = 0; m < mannequins.size(); ++m) {
+    ControllerStepper& cs = *mannequins[m].controller;
+    P.balance.push_back(std::make_unique<constraints::BalanceRows>(static_cast<int>(m), model_.mannequins[m].model,
                                                                    cs.controller().data(), pc.balance));
     P.support.emplace_back();
     P.support.back().reserve(static_cast<std::size_t>(pc.balance.max_points));
@@ -177,38 +120,16 @@ void World::buildPhysics() {
   // the balance controller (Algorithm 5 in the loop): one solver per mannequin, the frames it takes over
   const BalanceControllerConfig& bc = pc.balance_controller;
   if (bc.enabled) {
-    const std::string where = "sim: physics.balance_controller.";
-    if (!(bc.period > 0) || !std::isfinite(bc.period)) throw std::invalid_argument(where + "period must be finite and > 0");
-    if (bc.edges < 3) throw std::invalid_argument(where + "edges must be >= 3");
-    if (!(bc.max_step > 0) || !std::isfinite(bc.max_step)) throw std::invalid_argument(where + "max_step must be finite and > 0");
-    if (!(bc.max_task_step > 0) || !std::isfinite(bc.max_task_step))
-      throw std::invalid_argument(where + "max_task_step must be finite and > 0");
-    if (!(bc.dq_weight > 0) || !std::isfinite(bc.dq_weight)) throw std::invalid_argument(where + "dq_weight must be finite and > 0");
-    if (!(bc.posture_gain >= 0 && bc.posture_gain <= 1)) throw std::invalid_argument(where + "posture_gain must be in [0, 1]");
-    if (!(bc.joint_stiffness >= 0) || !std::isfinite(bc.joint_stiffness) || !(bc.joint_damping >= 0) || !std::isfinite(bc.joint_damping))
-      throw std::invalid_argument(where + "joint_stiffness and joint_damping must be finite and >= 0");
-    for (const math::Vector3& v : bc.force_margins)
-      if (!v.allFinite()) throw std::invalid_argument(where + "force_margins must be finite");
-    for (const auto& mp : mannequins_) {
-      Physics::BalanceLoop L(mp->model);
-      L.solver = std::make_unique<balance::VariationalBalanceSolver>(mp->model);
-      L.taken.assign(mp->frames.size(), 0);
-      L.k = skeleton::VectorX::Constant(mp->model.nv, bc.joint_stiffness);
-      L.b = skeleton::VectorX::Constant(mp->model.nv, bc.joint_damping);
+    for (std::size_t m = 0; m < mannequins.size(); ++m) {
+      const MannequinModel& mm = model_.mannequins[m];
+      PhysicsData::BalanceLoop L(mm.model);
+      L.solver = std::make_unique<balance::VariationalBalanceSolver>(mm.model);
+      L.taken.assign(mm.control_frames.size(), 0);
+      L.k = skeleton::VectorX::Constant(mm.model.nv, bc.joint_stiffness);
+      L.b = skeleton::VectorX::Constant(mm.model.nv, bc.joint_damping);
       L.k.head<6>().setZero();
       L.b.head<6>().setZero();
-      for (const std::string& f : bc.frames) {
-        std::size_t i = 0;
-        while (i < mp->frames.size() && mp->frames[i].frame != f) ++i;
-        if (i == mp->frames.size()) {
-          std::string driven;
-          for (const DrivenFrame& st : mp->frames) driven += (driven.empty() ? "" : ", ") + st.frame;
-          throw std::invalid_argument(where + "frames: '" + f + "' is not a driven frame of mannequin '" + mp->name +
-                                      "' (driven: " + driven + ")");
-        }
-        L.frames.push_back(static_cast<int>(i));
-        L.taken[i] = 1;
-      }
+      for (const int i : mm.balance_frames) L.taken[static_cast<std::size_t>(i)] = 1;
       P.balance_loops.push_back(std::move(L));
     }
   }
@@ -220,42 +141,42 @@ void World::buildPhysics() {
           const math::SE3 T = bs.pose * ps.pose;
           for (auto& b : P.balance) b->setFloor(T.act(ps.shape.normal * ps.shape.offset), T.R * ps.shape.normal);
         }
-  P.stepping.assign(mannequins_.size(), 0);
+  P.stepping.assign(mannequins.size(), 0);
   P.set.contacts.reserve(static_cast<std::size_t>(pc.solver.max_rows));
-  contacts_.reserve(static_cast<std::size_t>(pc.solver.max_rows));
+  data_->contacts.reserve(static_cast<std::size_t>(pc.solver.max_rows));
 }
 
-const collision::CollisionWorld* World::collisionWorld() const { return physics_ ? &physics_->cw : nullptr; }
-const constraints::ConstraintSolver* World::constraintSolver() const { return physics_ ? physics_->solver.get() : nullptr; }
+const collision::CollisionWorld* World::collisionWorld() const { return data_->physics ? &data_->physics->cw : nullptr; }
+const constraints::ConstraintSolver* World::constraintSolver() const { return data_->physics ? data_->physics->solver.get() : nullptr; }
 
-int World::numObjects() const { return physics_ ? static_cast<int>(physics_->objects.size()) : 0; }
+int World::numObjects() const { return data_->physics ? static_cast<int>(data_->physics->objects.size()) : 0; }
 const RigidObject& World::object(int i) const {
   if (i < 0 || i >= numObjects()) throw std::out_of_range("sim: no object " + std::to_string(i));
-  return physics_->objects[static_cast<std::size_t>(i)];
+  return data_->physics->objects[static_cast<std::size_t>(i)];
 }
 RigidObject& World::object(int i) {
   if (i < 0 || i >= numObjects()) throw std::out_of_range("sim: no object " + std::to_string(i));
-  return physics_->objects[static_cast<std::size_t>(i)];
+  return data_->physics->objects[static_cast<std::size_t>(i)];
 }
 int World::findObject(const std::string& name) const {
   for (int i = 0; i < numObjects(); ++i)
-    if (physics_->objects[static_cast<std::size_t>(i)].name() == name) return i;
+    if (data_->physics->objects[static_cast<std::size_t>(i)].name() == name) return i;
   return -1;
 }
 int World::objectBody(int i) const {
   (void)object(i);
-  return physics_->object_body[static_cast<std::size_t>(i)];
+  return data_->physics->object_body[static_cast<std::size_t>(i)];
 }
 
 int World::grasp(int m, const std::string& frame, const std::string& object_name) {
-  if (!physics_) throw std::invalid_argument("sim: grasp needs physics (physics.enabled)");
+  if (!data_->physics) throw std::invalid_argument("sim: grasp needs physics (physics.enabled)");
   if (m < 0 || m >= numMannequins()) throw std::invalid_argument("sim: grasp: no mannequin " + std::to_string(m));
-  const skeleton::Model& model = mannequins_[static_cast<std::size_t>(m)]->model;
+  const skeleton::Model& model = model_.mannequins[static_cast<std::size_t>(m)].model;
   const int f = model.findFrame(frame);
   if (f < 0) throw std::invalid_argument("sim: grasp: mannequin '" + name(m) + "' has no frame '" + frame + "'");
   const int o = findObject(object_name);
   if (o < 0) throw std::invalid_argument("sim: grasp: no object '" + object_name + "' (movable scene bodies with a mass)");
-  Physics& P = *physics_;
+  PhysicsData& P = *data_->physics;
   GraspRows::Hand hand;
   hand.system = m;
   hand.frames = P.frames[static_cast<std::size_t>(m)].get();
@@ -270,9 +191,9 @@ int World::grasp(int m, const std::string& frame, const std::string& object_name
 }
 
 bool World::release(int handle) {
-  if (!physics_ || !physics_->grasps || !physics_->grasps->release(handle)) return false;
-  Physics& P = *physics_;
-  const Physics::GraspRecord g = P.grasp_records[static_cast<std::size_t>(handle)];
+  if (!data_->physics || !data_->physics->grasps || !data_->physics->grasps->release(handle)) return false;
+  PhysicsData& P = *data_->physics;
+  const PhysicsData::GraspRecord g = P.grasp_records[static_cast<std::size_t>(handle)];
   P.grasp_records[static_cast<std::size_t>(handle)] = {};
   if (g.object >= 0 && g.mannequin >= 0 && !P.holds(g.mannequin, g.object))
     P.cw.setIgnoresMannequin(P.object_body[static_cast<std::size_t>(g.object)], P.cw_mannequin[static_cast<std::size_t>(g.mannequin)], false);
@@ -281,32 +202,32 @@ bool World::release(int handle) {
 
 bool World::objectHeld(int i) const {
   (void)object(i);
-  return physics_->grasps && physics_->grasps->held(i);
+  return data_->physics->grasps && data_->physics->grasps->held(i);
 }
 
 math::Vector3 World::graspForce(int handle) const {
-  if (!physics_ || !physics_->grasps || handle < 0 || static_cast<std::size_t>(handle) >= physics_->grasp_records.size() ||
-      physics_->grasp_records[static_cast<std::size_t>(handle)].object < 0)
+  if (!data_->physics || !data_->physics->grasps || handle < 0 || static_cast<std::size_t>(handle) >= data_->physics->grasp_records.size() ||
+      data_->physics->grasp_records[static_cast<std::size_t>(handle)].object < 0)
     return math::Vector3::Zero();
-  return physics_->grasps->force(handle);
+  return data_->physics->grasps->force(handle);
 }
 
 std::vector<GraspState> World::grasps() const {
   std::vector<GraspState> out;
-  if (!physics_ || !physics_->grasps) return out;
-  for (std::size_t h = 0; h < physics_->grasp_records.size(); ++h) {
-    const Physics::GraspRecord& g = physics_->grasp_records[h];
+  if (!data_->physics || !data_->physics->grasps) return out;
+  for (std::size_t h = 0; h < data_->physics->grasp_records.size(); ++h) {
+    const PhysicsData::GraspRecord& g = data_->physics->grasp_records[h];
     if (g.object < 0) continue;
-    out.push_back({static_cast<int>(h), g.mannequin, g.joint, g.object, physics_->grasps->force(static_cast<int>(h))});
+    out.push_back({static_cast<int>(h), g.mannequin, g.joint, g.object, data_->physics->grasps->force(static_cast<int>(h))});
   }
   return out;
 }
 
 std::array<math::Vector3, 2> World::handForces(int m) const {
   std::array<math::Vector3, 2> out{math::Vector3::Zero(), math::Vector3::Zero()};
-  if (!physics_ || m < 0 || m >= numMannequins()) return out;
-  const Physics& P = *physics_;
-  const skeleton::Model& model = mannequins_[static_cast<std::size_t>(m)]->model;
+  if (!data_->physics || m < 0 || m >= numMannequins()) return out;
+  const PhysicsData& P = *data_->physics;
+  const skeleton::Model& model = model_.mannequins[static_cast<std::size_t>(m)].model;
   std::array<int, 2> hand{-1, -1};  // the joints carrying the hand segments
   for (const skeleton::Segment& s : model.segments) {
     if (s.name == "hand_l") hand[0] = s.joint;
@@ -316,7 +237,7 @@ std::array<math::Vector3, 2> World::handForces(int m) const {
     if (hand[static_cast<std::size_t>(side)] < 0) continue;
     math::Vector3& f = out[static_cast<std::size_t>(side)];
     for (std::size_t h = 0; h < P.grasp_records.size(); ++h) {
-      const Physics::GraspRecord& g = P.grasp_records[h];
+      const PhysicsData::GraspRecord& g = P.grasp_records[h];
       if (g.object >= 0 && g.mannequin == m && g.joint == hand[static_cast<std::size_t>(side)])
         f -= P.grasps->force(static_cast<int>(h));
     }
@@ -325,7 +246,7 @@ std::array<math::Vector3, 2> World::handForces(int m) const {
              P.body_mannequin[static_cast<std::size_t>(body)] == m &&
              P.body_joint[static_cast<std::size_t>(body)] == hand[static_cast<std::size_t>(side)];
     };
-    for (const ContactReport& c : contacts_) {  // n from a to b: a gets −λ n, b gets +λ n
+    for (const ContactReport& c : data_->contacts) {  // n from a to b: a gets −λ n, b gets +λ n
       if (isHand(c.body_a)) f -= c.normal_force * c.normal;
       if (isHand(c.body_b)) f += c.normal_force * c.normal;
     }
@@ -336,13 +257,13 @@ std::array<math::Vector3, 2> World::handForces(int m) const {
 void World::kineticsInputs(int m, std::vector<kinetics::ContactPoint>& contacts, std::vector<kinetics::Load>& loads) const {
   contacts.clear();
   loads.clear();
-  if (!physics_ || m < 0 || m >= numMannequins()) return;
-  const Physics& P = *physics_;
+  if (!data_->physics || m < 0 || m >= numMannequins()) return;
+  const PhysicsData& P = *data_->physics;
   const skeleton::Data& d = data(m);
   const auto mannequinOf = [&](int body) {
     return body >= 0 && static_cast<std::size_t>(body) < P.body_mannequin.size() ? P.body_mannequin[static_cast<std::size_t>(body)] : -1;
   };
-  for (const ContactReport& c : contacts_) {  // n from a to b: the other body pushes a along −n, b along +n
+  for (const ContactReport& c : data_->contacts) {  // n from a to b: the other body pushes a along −n, b along +n
     if (!(c.normal_force > 0 || c.distance <= 0)) continue;
     const bool on_a = mannequinOf(c.body_a) == m, on_b = mannequinOf(c.body_b) == m;
     if (on_a == on_b) continue;  // not on m, or between two of its own segments (internal)
@@ -355,19 +276,19 @@ void World::kineticsInputs(int m, std::vector<kinetics::ContactPoint>& contacts,
     contacts.push_back(p);
   }
   for (std::size_t h = 0; h < P.grasp_records.size(); ++h) {
-    const Physics::GraspRecord& g = P.grasp_records[h];
+    const PhysicsData::GraspRecord& g = P.grasp_records[h];
     if (g.object < 0 || g.mannequin != m || g.joint < 0) continue;
     loads.push_back(kinetics::Load{g.joint, d.oMi[static_cast<std::size_t>(g.joint)].p, -P.grasps->force(static_cast<int>(h))});
   }
 }
 
 void World::attachGuide(int i, const control::MechanismSpec& spec) {
-  if (!physics_ || !physics_->guides) throw std::invalid_argument("sim: a guide needs physics and a scene with objects");
-  physics_->guides->attach(i, spec);
+  if (!data_->physics || !data_->physics->guides) throw std::invalid_argument("sim: a guide needs physics and a scene with objects");
+  data_->physics->guides->attach(i, spec);
 }
 
-bool World::detachGuide(int i) { return physics_ && physics_->guides && physics_->guides->detach(i); }
+bool World::detachGuide(int i) { return data_->physics && data_->physics->guides && data_->physics->guides->detach(i); }
 
-const GuideRows* World::guides() const { return physics_ ? physics_->guides.get() : nullptr; }
+const GuideRows* World::guides() const { return data_->physics ? data_->physics->guides.get() : nullptr; }
 
 }  // namespace mannequin::sim

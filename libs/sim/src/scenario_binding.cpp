@@ -12,16 +12,16 @@ void World::setScenario(scenario::Scenario sc) {
     for (int k = 0; k < numMannequins(); ++k)
       if (name(k) == f.mannequin) m = k;
     if (m < 0) throw std::invalid_argument(where + ": no mannequin '" + f.mannequin + "' in the World");
-    const Mannequin& mm = *mannequins_[static_cast<std::size_t>(m)];
-    std::size_t driven = mm.frames.size();
-    for (std::size_t i = 0; i < mm.frames.size(); ++i)
-      if (mm.frames[i].frame == f.frame) driven = i;
-    if (driven == mm.frames.size())
+    const MannequinModel& mm = model_.mannequins[static_cast<std::size_t>(m)];
+    std::size_t driven = mm.control_frames.size();
+    for (std::size_t i = 0; i < mm.control_frames.size(); ++i)
+      if (mm.control_frames[i].frame == f.frame) driven = i;
+    if (driven == mm.control_frames.size())
       throw std::invalid_argument(where + ": mannequin '" + f.mannequin + "' has no control frame '" + f.frame +
                                   "' driven by mocap (the sim config's control_frames)");
-    ScenarioRun::Frame fr{m, driven, mm.model.frames[static_cast<std::size_t>(mm.frames[driven].frame_index)].joint, {}};
+    ScenarioRun::Frame fr{m, driven, mm.model.frames[static_cast<std::size_t>(mm.frame_indices[driven])].joint, {}};
     std::vector<char> control_joint(mm.model.joints.size(), 0);
-    for (const DrivenFrame& d : mm.frames) control_joint[static_cast<std::size_t>(mm.model.frames[static_cast<std::size_t>(d.frame_index)].joint)] = 1;
+    for (const int fi : mm.frame_indices) control_joint[static_cast<std::size_t>(mm.model.frames[static_cast<std::size_t>(fi)].joint)] = 1;
     fr.force_joints.assign(mm.model.joints.size(), 0);
     for (std::size_t j = 0; j < mm.model.joints.size(); ++j) {
       int a = static_cast<int>(j);
@@ -31,7 +31,7 @@ void World::setScenario(scenario::Scenario sc) {
     run->frames.push_back(std::move(fr));
   }
   for (const scenario::ObjectDecl& o : sc.objects) {
-    const int k = physics_ ? findObject(o.name) : -1;
+    const int k = data_->physics ? findObject(o.name) : -1;
     if (k < 0) throw std::invalid_argument(where + ": no object '" + o.name + "' in the World (movable scene bodies, physics on)");
     std::vector<int> kinds;
     for (const std::string& v : o.values) {
@@ -63,12 +63,12 @@ void World::setScenario(scenario::Scenario sc) {
   run->obs.objects.resize(run->objects.size());
   for (std::size_t k = 0; k < run->objects.size(); ++k) run->obs.objects[k].values.resize(sc.objects[k].values.size());
   run->engine = std::make_unique<scenario::Engine>(std::move(sc));
-  if (scenario_) {
+  if (data_->scenario) {
     // the previous scenario's effects end with it: its mechanisms off, its grasps released, modes free
     // (gains it set stay)
-    ScenarioRun& S = *scenario_;
+    ScenarioRun& S = *data_->scenario;
     for (std::size_t i = 0; i < S.frames.size(); ++i) {
-      Mannequin& m = *mannequins_[static_cast<std::size_t>(S.frames[i].mannequin)];
+      MannequinData& m = data_->mannequins[static_cast<std::size_t>(S.frames[i].mannequin)];
       if (S.mechanism[i] != nullptr)
         if (ControllerStepper* cs = m.controller) cs->setMechanism(static_cast<int>(S.frames[i].driven), nullptr);
       if (S.grasp_handle[i] >= 0) release(S.grasp_handle[i]);
@@ -77,37 +77,37 @@ void World::setScenario(scenario::Scenario sc) {
     for (std::size_t k = 0; k < S.objects.size(); ++k)
       if (S.guided[k]) detachGuide(S.objects[k]);
   }
-  scenario_ = std::move(run);
+  data_->scenario = std::move(run);
 }
 
 void World::trigger(const std::string& name, const std::string& value) {
-  if (scenario_) scenario_->pending.push_back({name, value});
+  if (data_->scenario) data_->scenario->pending.push_back({name, value});
 }
 
-const scenario::Engine* World::scenarioEngine() const { return scenario_ ? scenario_->engine.get() : nullptr; }
-long World::scenarioUnappliedActions() const { return scenario_ ? scenario_->unapplied : 0; }
+const scenario::Engine* World::scenarioEngine() const { return data_->scenario ? data_->scenario->engine.get() : nullptr; }
+long World::scenarioUnappliedActions() const { return data_->scenario ? data_->scenario->unapplied : 0; }
 
 void World::stepScenario() {
-  ScenarioRun& S = *scenario_;
+  ScenarioRun& S = *data_->scenario;
   for (const ScenarioRun::Frame& f : S.frames)
-    if (!mannequins_[static_cast<std::size_t>(f.mannequin)]->calibrated) {
+    if (!data_->mannequins[static_cast<std::size_t>(f.mannequin)].calibrated) {
       S.pending.clear();  // not running yet: triggers are dropped, not queued for its first step
       return;
     }
   scenario::Observation& obs = S.obs;
   obs.time = time();
   for (std::size_t i = 0; i < S.frames.size(); ++i) {
-    const DrivenFrame& st = mannequins_[static_cast<std::size_t>(S.frames[i].mannequin)]->frames[S.frames[i].driven];
+    const DrivenFrame& st = data_->mannequins[static_cast<std::size_t>(S.frames[i].mannequin)].frames[S.frames[i].driven];
     obs.frames[i].pose = st.actual;
     obs.frames[i].target = st.target;  // the mocap target driveTargets just set
     obs.frames[i].force.setZero();
     if (S.grasp_handle[i] >= 0) obs.frames[i].force = -graspForce(S.grasp_handle[i]);  // the object's pull on the hand
   }
-  if (physics_) {
+  if (data_->physics) {
     // the contact forces of the last step on each commanded frame's segments (normal forces: the friction
     // rows' directions are not reported); a contact's force on body a is −λ n (n from a to b)
-    const Physics& P = *physics_;
-    for (const ContactReport& c : contacts_)
+    const PhysicsData& P = *data_->physics;
+    for (const ContactReport& c : data_->contacts)
       for (std::size_t i = 0; i < S.frames.size(); ++i) {
         const ScenarioRun::Frame& f = S.frames[i];
         const auto on = [&](int body) {
@@ -134,7 +134,7 @@ void World::stepScenario() {
   for (const scenario::ActionCommand& a : r.actions) {
     const scenario::Action& act = *a.action;
     const bool frame_ok = act.frame >= 0 && static_cast<std::size_t>(act.frame) < S.frames.size();
-    if (act.kind == scenario::Action::Kind::kGrasp && frame_ok && act.object >= 0 && physics_) {
+    if (act.kind == scenario::Action::Kind::kGrasp && frame_ok && act.object >= 0 && data_->physics) {
       const ScenarioRun::Frame& f = S.frames[static_cast<std::size_t>(act.frame)];
       int& held = S.grasp_handle[static_cast<std::size_t>(act.frame)];
       if (held >= 0) release(held);  // one grasp per frame: a second one replaces the first
@@ -142,7 +142,7 @@ void World::stepScenario() {
           grasp(f.mannequin, sc.frames[static_cast<std::size_t>(act.frame)].frame, sc.objects[static_cast<std::size_t>(act.object)].name);
     } else if (act.kind == scenario::Action::Kind::kSetGains && frame_ok) {
       const ScenarioRun::Frame& f = S.frames[static_cast<std::size_t>(act.frame)];
-      ControllerStepper* cs = mannequins_[static_cast<std::size_t>(f.mannequin)]->controller;
+      ControllerStepper* cs = data_->mannequins[static_cast<std::size_t>(f.mannequin)].controller;
       if (cs == nullptr) {
         ++S.unapplied;  // the kinematic tracker has no gains to set
       } else {
@@ -152,7 +152,7 @@ void World::stepScenario() {
           ++S.unapplied;  // bad gains are refused at load: not expected
         }
       }
-    } else if (act.kind == scenario::Action::Kind::kAttachGuide && act.object >= 0 && act.mechanism && physics_) {
+    } else if (act.kind == scenario::Action::Kind::kAttachGuide && act.object >= 0 && act.mechanism && data_->physics) {
       const std::size_t k = static_cast<std::size_t>(act.object);
       try {
         attachGuide(S.objects[k], act.mechanism->spec);
@@ -160,7 +160,7 @@ void World::stepScenario() {
       } catch (const std::invalid_argument&) {
         ++S.unapplied;  // validated at setScenario: not expected
       }
-    } else if (act.kind == scenario::Action::Kind::kDetachGuide && act.object >= 0 && physics_) {
+    } else if (act.kind == scenario::Action::Kind::kDetachGuide && act.object >= 0 && data_->physics) {
       const std::size_t k = static_cast<std::size_t>(act.object);
       detachGuide(S.objects[k]);  // a guide already off is not an error: the state asked for it off
       S.guided[k] = 0;
@@ -174,7 +174,7 @@ void World::stepScenario() {
   }
   for (std::size_t i = 0; i < S.frames.size(); ++i) {
     const scenario::FrameCommand& c = r.frames[i];
-    Mannequin& m = *mannequins_[static_cast<std::size_t>(S.frames[i].mannequin)];
+    MannequinData& m = data_->mannequins[static_cast<std::size_t>(S.frames[i].mannequin)];
     DrivenFrame& st = m.frames[S.frames[i].driven];
     st.target = c.setpoint.pose;
     st.mode = scenario::toString(c.mode);

@@ -4,100 +4,85 @@
 
 namespace mannequin::sim {
 
-World::World(std::vector<MannequinSetup> setups, const SimConfig& config) : config_(config) {
-  if (!(config_.step > 0) || !std::isfinite(config_.step)) throw std::invalid_argument("sim: step must be > 0");
-  sources_.push_back(std::make_unique<Source>());  // the default source ""
-  std::set<std::string> names;
-  for (MannequinSetup& s : setups) {
-    if (!names.insert(s.name).second) throw std::invalid_argument("sim: two mannequins named '" + s.name + "'");
-    auto m = std::make_unique<Mannequin>();
-    if (findSource(s.mocap_source) == nullptr) {
-      sources_.push_back(std::make_unique<Source>());
-      sources_.back()->name = s.mocap_source;
-    }
-    for (std::size_t i = 0; i < sources_.size(); ++i)
-      if (sources_[i]->name == s.mocap_source) m->source = static_cast<int>(i);
-    m->name = s.name;
-    m->model = std::move(s.model);
-    m->specs = s.frames;
-    m->root_frame = m->model.findFrame(s.root_frame);
-    std::vector<int> idx;
-    for (const ControlFrameSpec& f : s.frames) {
+World::World(std::vector<MannequinSetup> setups, const SimConfig& config)
+    : World(buildWorldModel(std::move(setups), config)) {}
+
+World::World(WorldModel model) : model_(std::move(model)), data_(std::make_unique<WorldData>()) {
+  WorldData& D = *data_;
+  D.sources.resize(model_.sources.size());
+  D.mannequins.resize(model_.mannequins.size());
+  for (std::size_t k = 0; k < model_.mannequins.size(); ++k) {
+    const MannequinModel& mm = model_.mannequins[k];
+    MannequinData& md = D.mannequins[k];
+    for (std::size_t i = 0; i < mm.control_frames.size(); ++i) {
       DrivenFrame st;
-      st.frame = f.frame;
-      st.body = f.body;
-      try {
-        st.frame_index = m->model.frameIndex(f.frame);
-      } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument("sim: mannequin '" + s.name + "': " + e.what());
-      }
-      idx.push_back(st.frame_index);
-      m->frames.push_back(st);
+      st.frame = mm.control_frames[i].frame;
+      st.body = mm.control_frames[i].body;
+      st.frame_index = mm.frame_indices[i];
+      md.frames.push_back(st);
     }
-    m->weights.assign(m->frames.size(), 0.0);
-    m->catch_p.assign(m->frames.size(), math::Vector3::Zero());
-    m->catch_r.assign(m->frames.size(), math::Vector3::Zero());
-    m->q_standing = skeleton::standingConfiguration(m->model);
-    m->frame_indices = idx;
-    if (s.controller && config_.physics.enabled) {
-      if (!config_.physics.gravity.allFinite())
-        throw std::invalid_argument("sim: physics.gravity must be finite");
-      s.controller->gravity = config_.physics.gravity;
-    }
-    if (s.controller) {
+    const std::size_t n = md.frames.size();
+    md.weights.assign(n, 0.0);
+    md.catch_p.assign(n, math::Vector3::Zero());
+    md.catch_r.assign(n, math::Vector3::Zero());
+    if (mm.controller) {
       try {
-        auto controller = std::make_unique<ControllerStepper>(m->model, *s.controller, idx, config_.step, m->q_standing,
-                                                              config_.joint_limits);
-        m->controller = controller.get();
-        m->stepper = std::move(controller);
+        auto controller = std::make_unique<ControllerStepper>(mm.model, *mm.controller, mm.frame_indices, model_.config.step,
+                                                              mm.q_standing, model_.config.joint_limits);
+        md.controller = controller.get();
+        md.stepper = std::move(controller);
       } catch (const std::invalid_argument& e) {
-        throw std::invalid_argument("sim: mannequin '" + s.name + "': " + e.what());
+        throw std::invalid_argument("sim: mannequin '" + mm.name + "': " + e.what());
       }
     } else {
-      m->stepper = std::make_unique<KinematicTracker>(m->model, idx, config_.gains, m->q_standing);
+      md.stepper = std::make_unique<KinematicTracker>(mm.model, mm.frame_indices, model_.config.gains, mm.q_standing);
     }
-    m->previous_targets.resize(idx.size());
-    m->have_previous.assign(idx.size(), false);
-    for (auto& st : m->frames) st.target = st.actual = m->stepper->data().oMf[st.frame_index];
-    mannequins_.push_back(std::move(m));
+    md.previous_targets.resize(n);
+    md.have_previous.assign(n, false);
+    for (auto& st : md.frames) st.target = st.actual = md.stepper->data().oMf[st.frame_index];
   }
-  mannequin_diagnostics_.assign(mannequins_.size(), MannequinDiagnostics{});
-  if (config_.physics.enabled) buildPhysics();
+  D.mannequin_diagnostics.assign(model_.mannequins.size(), MannequinDiagnostics{});
+  if (model_.physics) buildPhysics();
 }
 
 const skeleton::VectorX* World::balanceConfiguration(int m) const {
-  if (!physics_ || physics_->balance_loops.empty()) return nullptr;
-  const Physics::BalanceLoop& L = physics_->balance_loops.at(static_cast<std::size_t>(m));
+  if (!data_->physics || data_->physics->balance_loops.empty()) return nullptr;
+  const PhysicsData::BalanceLoop& L = data_->physics->balance_loops.at(static_cast<std::size_t>(m));
   return L.driving ? &L.q_b : nullptr;
 }
 
 const MannequinDiagnostics& World::mannequinDiagnostics(int m) const {
-  return mannequin_diagnostics_.at(static_cast<std::size_t>(m));
+  return data_->mannequin_diagnostics.at(static_cast<std::size_t>(m));
 }
 
 World::~World() = default;
 
 
-const std::string& World::name(int m) const { return mannequins_.at(m)->name; }
-const skeleton::Model& World::model(int m) const { return mannequins_.at(m)->model; }
-const skeleton::Data& World::data(int m) const { return mannequins_.at(m)->stepper->data(); }
-const skeleton::VectorX& World::q(int m) const { return mannequins_.at(m)->stepper->q(); }
-const skeleton::VectorX& World::qdot(int m) const { return mannequins_.at(m)->stepper->qdot(); }
-bool World::calibrated(int m) const { return mannequins_.at(m)->calibrated; }
-const Stepper& World::stepper(int m) const { return *mannequins_.at(m)->stepper; }
-const std::vector<DrivenFrame>& World::controlFrames(int m) const { return mannequins_.at(m)->frames; }
+std::uint64_t World::stepCount() const { return data_->steps; }
+std::uint64_t World::failedSteps() const { return data_->failed_steps; }
+const MocapGlitches& World::mocapGlitches() const { return data_->glitches; }
+const StepDiagnostics& World::diagnostics() const { return data_->diagnostics; }
+const std::vector<ContactReport>& World::contacts() const { return data_->contacts; }
+const std::string& World::name(int m) const { return model_.mannequins.at(static_cast<std::size_t>(m)).name; }
+const skeleton::Model& World::model(int m) const { return model_.mannequins.at(static_cast<std::size_t>(m)).model; }
+const skeleton::Data& World::data(int m) const { return data_->mannequins.at(static_cast<std::size_t>(m)).stepper->data(); }
+const skeleton::VectorX& World::q(int m) const { return data_->mannequins.at(static_cast<std::size_t>(m)).stepper->q(); }
+const skeleton::VectorX& World::qdot(int m) const { return data_->mannequins.at(static_cast<std::size_t>(m)).stepper->qdot(); }
+bool World::calibrated(int m) const { return data_->mannequins.at(static_cast<std::size_t>(m)).calibrated; }
+const Stepper& World::stepper(int m) const { return *data_->mannequins.at(static_cast<std::size_t>(m)).stepper; }
+const std::vector<DrivenFrame>& World::controlFrames(int m) const { return data_->mannequins.at(static_cast<std::size_t>(m)).frames; }
 
 bool World::step() {
   detectStreamGaps();
-  for (auto& mp : mannequins_) driveTargets(*mp, config_.step);
-  for (auto& src : sources_) src->back = false;  // the catch-ups after a gap or a re-anchor have started
-  if (physics_ && !physics_->balance_loops.empty())
-    for (std::size_t m = 0; m < mannequins_.size(); ++m) applyBalanceTargets(m);
-  if (scenario_) stepScenario();
-  const bool ok = physics_ ? physicsStep() : kinematicStep();
-  diagnostics_.nan = !ok;
+  for (std::size_t m = 0; m < data_->mannequins.size(); ++m) driveTargets(m, model_.config.step);
+  for (SourceData& src : data_->sources) src.back = false;  // the catch-ups after a gap or a re-anchor have started
+  if (data_->physics && !data_->physics->balance_loops.empty())
+    for (std::size_t m = 0; m < data_->mannequins.size(); ++m) applyBalanceTargets(m);
+  if (data_->scenario) stepScenario();
+  const bool ok = data_->physics ? physicsStep() : kinematicStep();
+  data_->diagnostics.nan = !ok;
   updateFrameErrors();
-  ++steps_;
+  ++data_->steps;
   return ok;
 }
 

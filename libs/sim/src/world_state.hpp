@@ -1,9 +1,10 @@
 #pragma once
-// The World's private state, shared by its source files (world.cpp and the stage files beside it):
-// the physics scene (World::Physics), the mocap sources (World::Source), the mannequins
-// (World::Mannequin) and the scenario binding (World::ScenarioRun). Not installed: only libs/sim/src
-// includes it.
+// WorldData: the mutable state of a World, sized from its WorldModel and shared by its source files
+// (world.cpp and the stage files beside it): per mannequin its MannequinData, per mocap source its
+// SourceData, the physics runtime (PhysicsData), the scenario binding (ScenarioRun), the step's
+// contacts, diagnostics and counters. Not installed: only libs/sim/src includes it.
 #include "mannequin/sim/world.hpp"
+#include "mannequin/sim/world_model.hpp"
 
 #include "mannequin/balance/static_balance.hpp"
 #include "mannequin/balance/variational_balance.hpp"
@@ -34,7 +35,8 @@ constexpr double kCatchUpSpeed = 1.0;    // m/s: a target catching up with its b
 /// their bounds, ball joints against their swing ellipse and twist range (diagnostics.cpp).
 double worstLimitExcess(const skeleton::Model& model, const skeleton::VectorX& q);
 
-struct World::Physics {
+/// The physics runtime of a World (built from WorldModel::physics by World::buildPhysics).
+struct PhysicsData {
   collision::CollisionWorld cw;
   std::vector<int> cw_mannequin;                       // per mannequin: index in cw
   std::vector<std::unique_ptr<MannequinSystem>> systems;
@@ -67,8 +69,7 @@ struct World::Physics {
   struct BalanceLoop {
     std::unique_ptr<balance::VariationalBalanceSolver> solver;
     balance::VariationalBalanceProblem problem;
-    std::vector<int> frames;       // driven frames (indices in Mannequin::frames) it takes over
-    std::vector<char> taken;       // per driven frame: in `frames`
+    std::vector<char> taken;       // per driven frame: taken over (MannequinModel::balance_frames)
     skeleton::Data data;           // kinematics at q_b
     skeleton::VectorX q_b;         // the controller's own configuration: Algorithm 5 iterates on it
     bool driving = false;          // q_b exists and drives the frames and the posture
@@ -77,7 +78,7 @@ struct World::Physics {
     explicit BalanceLoop(const skeleton::Model& model) : data(model) {}
   };
   std::vector<BalanceLoop> balance_loops;              // per mannequin when the controller is on
-  explicit Physics(const collision::WorldOptions& o) : cw(o) {}
+  explicit PhysicsData(const collision::WorldOptions& o) : cw(o) {}
   /// Whether mannequin m holds object o (contacts between them are ignored).
   bool holds(int m, int o) const {
     for (const GraspRecord& g : grasp_records)
@@ -86,9 +87,9 @@ struct World::Physics {
   }
 };
 
-/// A mocap source: its frames, and the anchor of its capture clock to the World clock.
-struct World::Source {
-  std::string name;
+/// The state of a mocap source (WorldModel::sources): its frames, and the anchor of its capture clock to
+/// the World clock.
+struct SourceData {
   MocapBuffer buffer{2.0};
   bool anchored = false;
   bool gap = false;   // its newest frame is older than occlusion_hold (counted once per gap)
@@ -97,29 +98,23 @@ struct World::Source {
   std::uint64_t anchor_step = 0;
 };
 
-struct World::Mannequin {
-  std::string name;
-  skeleton::Model model;
-  std::vector<ControlFrameSpec> specs;
-  int root_frame = -1;
-  int source = 0;  // index in World::sources_
-  std::vector<int> frame_indices;
-  std::unique_ptr<Stepper> stepper;
+/// The state of a mannequin (WorldModel::mannequins).
+struct MannequinData {
+  std::unique_ptr<Stepper> stepper;         // its skeleton Data, q and q̇
   ControllerStepper* controller = nullptr;  // the stepper when it is a ControllerStepper (physics needs it), else nullptr
-  std::vector<DrivenFrame> frames;
+  std::vector<DrivenFrame> frames;          // per control frame
   std::vector<math::SE3> previous_targets;  // targets of the previous step (target twist)
   std::vector<bool> have_previous;
   std::vector<double> weights;  // current weights (rate-limited)
   // after a stream gap: the offset (world, m and rotation vector) of each target from its body, shrinking at kCatchUpSpeed
   std::vector<math::Vector3> catch_p, catch_r;
   bool calibrated = false;
-  skeleton::VectorX q_standing;
   skeleton::VectorX q_posture;  // q_c: the posture target set at calibration
   bool holding_restored = false;  // restored calibrated, its source not anchored yet: holds the restored targets
 };
 
 /// A scenario in the loop: its engine, where its frames and objects are in this World.
-struct World::ScenarioRun {
+struct ScenarioRun {
   std::unique_ptr<scenario::Engine> engine;
   struct Frame {
     int mannequin = -1;
@@ -138,6 +133,20 @@ struct World::ScenarioRun {
   std::vector<scenario::Trigger> pending;
   scenario::Observation obs;
   long unapplied = 0;
+};
+
+/// Everything a World's step changes.
+struct WorldData {
+  std::vector<MannequinData> mannequins;  // per WorldModel::mannequins
+  std::vector<SourceData> sources;        // per WorldModel::sources
+  std::uint64_t steps = 0, failed_steps = 0;
+  MocapGlitches glitches;
+  std::vector<std::size_t> jumps;  // addMocap: the bodies of a frame that jumped (kept: no allocation per frame)
+  std::unique_ptr<ScenarioRun> scenario;
+  std::unique_ptr<PhysicsData> physics;
+  StepDiagnostics diagnostics;
+  std::vector<MannequinDiagnostics> mannequin_diagnostics;  // per mannequin
+  std::vector<ContactReport> contacts;                      // the last step's
 };
 
 }  // namespace mannequin::sim

@@ -2,6 +2,9 @@
 /// \file world.hpp
 /// \brief The simulated world the sim service steps: mannequins driven by calibrated mocap bodies.
 ///
+/// A World is its constant WorldModel (world_model.hpp: mannequins, control frames, sources, config,
+/// physics scene; built and checked once by buildWorldModel) and the WorldData its steps change.
+///
 /// Time: the World steps by a fixed δt (SimConfig::step). Its clock is tied to the capture clock of the
 /// mocap stream by anchor(): capture time = anchor capture time + (World time − anchor World time) −
 /// interpolation_delay. Targets are sampled from the MocapBuffer at that capture time.
@@ -40,6 +43,7 @@
 #include "mannequin/sim/object_guides.hpp"
 #include "mannequin/sim/rigid_object.hpp"
 #include "mannequin/sim/stepper.hpp"
+#include "mannequin/sim/world_model.hpp"
 
 namespace mannequin::scenario {
 class Engine;
@@ -48,12 +52,25 @@ struct Scenario;
 
 namespace mannequin::sim {
 
+struct WorldData;  // src/world_state.hpp
+
 class World {
  public:
   /// \throws std::invalid_argument naming an unknown frame (with the model's frames), a step <= 0,
   /// or two mannequins with the same name.
   World(std::vector<MannequinSetup> mannequins, const SimConfig& config);
+  /// A World of a model buildWorldModel() built (it builds the steppers and, with physics, the scene).
+  /// \throws std::invalid_argument naming the mannequin whose controller config its controller refuses,
+  /// or a scene object that cannot be built.
+  explicit World(WorldModel model);
   ~World();
+  World(const World&) = delete;
+  World& operator=(const World&) = delete;
+  World(World&&) = delete;
+  World& operator=(World&&) = delete;
+
+  /// The World's constant description (its mannequins, sources, config and physics scene).
+  const WorldModel& worldModel() const { return model_; }
 
   /// Adds a mocap frame of `source` (ignored if not newer than that source's last, unless it is older by
   /// more than the buffer window: a restarted capture clock, MocapGlitches::capture_restarts). Tracked
@@ -85,10 +102,10 @@ class World {
   /// mannequins or objects, another model, a size, a non-finite number, another set of driven frames.
   std::vector<std::string> restore(const WorldCheckpoint& checkpoint);
 
-  double time() const { return static_cast<double>(steps_) * config_.step; }
-  std::uint64_t stepCount() const { return steps_; }
-  const SimConfig& config() const { return config_; }
-  int numMannequins() const { return static_cast<int>(mannequins_.size()); }
+  double time() const { return static_cast<double>(stepCount()) * model_.config.step; }
+  std::uint64_t stepCount() const;
+  const SimConfig& config() const { return model_.config; }
+  int numMannequins() const { return static_cast<int>(model_.mannequins.size()); }
   const std::string& name(int m) const;
   const skeleton::Model& model(int m) const;
   const skeleton::Data& data(int m) const;      ///< kinematics at q (oMi, oMf, com after step)
@@ -100,21 +117,21 @@ class World {
   const std::vector<DrivenFrame>& controlFrames(int m) const;
   /// The newest mocap frame added to `source` (nullptr before any, or an unknown source).
   const mocap::Frame* latestMocap(const std::string& source = "") const;
-  std::uint64_t failedSteps() const { return failed_steps_; }
+  std::uint64_t failedSteps() const;
   /// The mocap glitches met so far (MocapGlitches).
-  const MocapGlitches& mocapGlitches() const { return glitches_; }
+  const MocapGlitches& mocapGlitches() const;
 
   //---- physics (PhysicsConfig::enabled) ----
-  bool physics() const { return config_.physics.enabled; }
+  bool physics() const { return model_.config.physics.enabled; }
   /// The collision world of the physics (scene, mannequin segments, objects); nullptr when off.
   const collision::CollisionWorld* collisionWorld() const;
-  const StepDiagnostics& diagnostics() const { return diagnostics_; }
+  const StepDiagnostics& diagnostics() const;
   const MannequinDiagnostics& mannequinDiagnostics(int m) const;
   /// The balance controller's configuration q_b of mannequin m (PhysicsConfig::balance_controller),
   /// nullptr while it does not drive the mannequin.
   const skeleton::VectorX* balanceConfiguration(int m) const;
   /// Contacts of the last step (empty when physics is off).
-  const std::vector<ContactReport>& contacts() const { return contacts_; }
+  const std::vector<ContactReport>& contacts() const;
   /// The constraint solver (nullptr when physics is off).
   const constraints::ConstraintSolver* constraintSolver() const;
 
@@ -186,24 +203,21 @@ class World {
   const GuideRows* guides() const;
 
  private:
-  // The private state (src/world_state.hpp) and the stages of step(), each in the source file named.
-  struct Mannequin;
-  struct Physics;
-  struct Source;
-  struct ScenarioRun;
+  // The stages of step() and their helpers, each in the source file named (libs/sim/src); the state
+  // they change is data_ (WorldData, src/world_state.hpp).
   //---- mocap input (mocap_input.cpp) ----
-  Source* findSource(const std::string& name);
-  const Source* findSource(const std::string& name) const;
+  /// Index of the mocap source `name` in model_.sources, −1 if none.
+  int findSource(const std::string& name) const { return model_.findSource(name); }
   /// Stage: counts the sources whose newest frame got older than occlusion_hold (MocapGlitches::stream_gaps).
   void detectStreamGaps();
   //---- calibration (calibration.cpp) ----
-  void calibrate(Mannequin& m, const mocap::Frame& frame);
+  void calibrate(std::size_t m, const mocap::Frame& frame);
   /// Distance after margins of mannequin m's lowest sole to the floor at q (m; +inf: no floor).
-  double soleGap(Mannequin& m, const skeleton::VectorX& q);
+  double soleGap(std::size_t m, const skeleton::VectorX& q);
   //---- targets (drive_targets.cpp) ----
-  /// Stage: the targets of m's control frames from their mocap bodies at the capture time of this step.
-  void driveTargets(Mannequin& m, double dt);
-  math::Vector6 targetTwist(Mannequin& m, std::size_t i, double dt) const;
+  /// Stage: the targets of mannequin m's control frames from their mocap bodies at the capture time of this step.
+  void driveTargets(std::size_t m, double dt);
+  math::Vector6 targetTwist(std::size_t m, std::size_t i, double dt);
   //---- the scenario (scenario_binding.cpp) ----
   /// Stage: the scenario engine's step; its setpoints replace the commanded frames' targets.
   void stepScenario();
@@ -232,17 +246,8 @@ class World {
   /// Stage: the frames the balance controller took over get their poses at q_b as targets.
   void applyBalanceTargets(std::size_t m);
 
-  std::vector<std::unique_ptr<Mannequin>> mannequins_;
-  SimConfig config_;
-  std::vector<std::unique_ptr<Source>> sources_;  // "" first
-  std::uint64_t steps_ = 0, failed_steps_ = 0;
-  MocapGlitches glitches_;
-  std::vector<std::size_t> jumps_;  // addMocap: the bodies of a frame that jumped (kept: no allocation per frame)
-  std::unique_ptr<ScenarioRun> scenario_;
-  std::unique_ptr<Physics> physics_;
-  StepDiagnostics diagnostics_;
-  std::vector<MannequinDiagnostics> mannequin_diagnostics_;
-  std::vector<ContactReport> contacts_;
+  const WorldModel model_;            // the controllers hold references into it: a World is not moved
+  std::unique_ptr<WorldData> data_;
 };
 
 }  // namespace mannequin::sim
