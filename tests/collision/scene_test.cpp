@@ -197,7 +197,7 @@ TEST(Scene, ShippedScenesLoadAndCockpitPanelIsDense) {
   EXPECT_GE(tris, 10000u);
 }
 
-// Dynamics of movable bodies (sim::RigidObject): mass, inertia (default: solid bounding box), hinge.
+// Dynamics of movable bodies (constraints::RigidObject): mass, inertia (default: solid bounding box), hinge.
 TEST(Scene, MovableBodyDynamics) {
   const SceneSpec s = parseScene(
       "bodies:\n"

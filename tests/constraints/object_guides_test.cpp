@@ -24,8 +24,8 @@ namespace ctl = mannequin::control;
 using mannequin::testing::kDt;
 using mannequin::testing::kGravity;
 
-sim::RigidObjectSpec boxSpec(const SE3& pose, double mass = 2.0) {
-  sim::RigidObjectSpec s;
+cs::RigidObjectSpec boxSpec(const SE3& pose, double mass = 2.0) {
+  cs::RigidObjectSpec s;
   s.name = "part";
   s.pose = pose;
   s.mass = mass;
@@ -61,7 +61,7 @@ TEST(ObjectGuide, EveryRowsJacobianIsTheRateOfItsDistance) {
       // near the base (within the stops' activation), turned and shifted off the manifold
       const SE3 pose = base * SE3(mannequin::math::expSO3(0.2 * Vector3(u(rng), u(rng), u(rng))),
                                   Vector3(0.03 * u(rng), 0.03 * u(rng), 0.02 * u(rng)));
-      sim::RigidObject obj(boxSpec(pose));
+      cs::RigidObject obj(boxSpec(pose));
       sim::GuideRows guides({&obj}, {0}, 0.5);
       const int d = ctl::mechanismDimension(type);
       std::vector<std::pair<double, double>> stops(static_cast<std::size_t>(d), {-0.1, 0.1});
@@ -102,7 +102,7 @@ TEST(ObjectGuide, EveryRowsJacobianIsTheRateOfItsDistance) {
 // never leaves the axis or turns, and rests on the lower stop, where the guide carries its whole weight.
 TEST(ObjectGuide, APartOnATiltedAxisSlidesDownToItsStopWithoutLeavingTheAxis) {
   const SE3 base(mannequin::math::expSO3(Vector3(M_PI / 6, 0, 0)), Vector3(0.5, 0, 1.0));
-  sim::RigidObject part(boxSpec(base));
+  cs::RigidObject part(boxSpec(base));
   cs::ConstraintSolver solver({&part});
   sim::GuideRows guides({&part}, {0});
   solver.addProducer(&guides);
@@ -137,7 +137,7 @@ TEST(ObjectGuide, APartOnATiltedAxisSlidesDownToItsStopWithoutLeavingTheAxis) {
 TEST(ObjectGuide, AttachedOffTheAxisThePartComesOntoItAtTheRecoverySpeed) {
   const SE3 base(Matrix3::Identity(), Vector3(0, 0, 1.0));
   const SE3 start(mannequin::math::expSO3(Vector3(0.14, 0, 0)), Vector3(0.03, 0, 1.0));
-  sim::RigidObject part(boxSpec(start));
+  cs::RigidObject part(boxSpec(start));
   cs::ConstraintSolver solver({&part});
   const double v_rec = 0.3;
   sim::GuideRows guides({&part}, {0}, 0.05, v_rec);
@@ -166,7 +166,7 @@ TEST(ObjectGuide, AttachedOffTheAxisThePartComesOntoItAtTheRecoverySpeed) {
 // it tilts nothing, and a push along the axis moves it along.
 TEST(ObjectGuide, ASlidingPivotLetsThePartTurnAndSlideAboutItsAxisOnly) {
   const SE3 base(Matrix3::Identity(), Vector3(0, 0, 1.0));
-  sim::RigidObject part(boxSpec(base));
+  cs::RigidObject part(boxSpec(base));
   cs::ConstraintSolver solver({&part});
   sim::GuideRows guides({&part}, {0});
   solver.addProducer(&guides);
@@ -198,7 +198,7 @@ TEST(ObjectGuide, ASlidingPivotLetsThePartTurnAndSlideAboutItsAxisOnly) {
 // height; pushed sideways it slides in its plane; it turns about the vertical freely. detach() lets it go.
 TEST(ObjectGuide, APlaneKeepsATrayLevelUnderAnOffCentreLoadAndLetsItSlide) {
   const SE3 base(Matrix3::Identity(), Vector3(0.4, 0.2, 1.1));
-  sim::RigidObject tray(boxSpec(base, 1.0));
+  cs::RigidObject tray(boxSpec(base, 1.0));
   cs::ConstraintSolver solver({&tray});
   sim::GuideRows guides({&tray}, {0});
   solver.addProducer(&guides);
@@ -225,11 +225,11 @@ TEST(ObjectGuide, APlaneKeepsATrayLevelUnderAnOffCentreLoadAndLetsItSlide) {
 }
 
 TEST(ObjectGuide, WhatAGuideCannotBeIsRefusedSayingWhy) {
-  sim::RigidObject part(boxSpec(SE3()));
-  sim::RigidObjectSpec door_spec = boxSpec(SE3());
+  cs::RigidObject part(boxSpec(SE3()));
+  cs::RigidObjectSpec door_spec = boxSpec(SE3());
   door_spec.name = "door";
   door_spec.hinge = mannequin::collision::HingeSpec{Vector3::UnitZ(), Vector3::Zero(), -1.0, 1.0};
-  sim::RigidObject door(door_spec);
+  cs::RigidObject door(door_spec);
   sim::GuideRows guides({&part, &door}, {0, 1});
   std::string why;
   ctl::MechanismSpec curve = mechanism(ctl::MechanismType::kCurve, SE3());

@@ -9,7 +9,7 @@
 #include "mannequin/collision/scene.hpp"
 #include "mannequin/control/config.hpp"
 #include "mannequin/sim/object_guides.hpp"
-#include "mannequin/sim/rigid_object.hpp"
+#include "mannequin/constraints/objects.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "../common/alloc_counter.hpp"
@@ -21,20 +21,20 @@ namespace cs = mannequin::constraints;
 namespace sim = mannequin::sim;
 
 TEST(RigidObjectAlloc, StagesAndProducersAllocateNothing) {
-  sim::RigidObjectSpec free_spec;
+  cs::RigidObjectSpec free_spec;
   free_spec.name = "ball";
   free_spec.pose.p = Vector3(0, 0, 1);
-  sim::RigidObjectSpec hinge_spec;
+  cs::RigidObjectSpec hinge_spec;
   hinge_spec.name = "lever";
   hinge_spec.pose.p = Vector3(0, 0, 0.2);
   hinge_spec.hinge = mannequin::collision::HingeSpec{Vector3::UnitY(), Vector3::Zero(), -0.1, 0.1};
-  sim::RigidObjectSpec hand_spec;
+  cs::RigidObjectSpec hand_spec;
   hand_spec.name = "hand";
   hand_spec.pose.p = Vector3(0, 0, 1.1);
-  sim::RigidObject ball(free_spec), lever(hinge_spec), hand(hand_spec);
+  cs::RigidObject ball(free_spec), lever(hinge_spec), hand(hand_spec);
   cs::RowSet rows({6, 1, 6}, 32, 8, 4);
-  sim::HingeLimitRows limits({{&lever, 1}});
-  sim::GraspRows grasps({&ball, &lever}, {0, 1}, 6);
+  cs::HingeLimitRows limits({{&lever, 1}});
+  cs::GraspRows grasps({&ball, &lever}, {0, 1}, 6);
   // a guide on the "hand" object: a sliding pivot with stops 1 cm either side (two tilt rows, two position
   // rows, both stops within its 0.5 m activation: the unconstrained test motion drifts a few cm)
   sim::GuideRows guides({&ball, &lever, &hand}, {0, 1, 2}, 0.5);
@@ -50,7 +50,7 @@ TEST(RigidObjectAlloc, StagesAndProducersAllocateNothing) {
   int handle = grasps.grasp({2, &hand, 0}, 0);
   ASSERT_GE(handle, 0);
   const auto step = [&] {
-    for (sim::RigidObject* o : {&ball, &lever, &hand}) o->computeFreeMotion(gravity, 0.001);
+    for (cs::RigidObject* o : {&ball, &lever, &hand}) o->computeFreeMotion(gravity, 0.001);
     lever.addForce(Vector3(0, 0, 0.3), Vector3(1, 0, 0));
     rows.clear();
     limits.addRows(0, 0.001, rows);
@@ -62,7 +62,7 @@ TEST(RigidObjectAlloc, StagesAndProducersAllocateNothing) {
     ball.applyConstraintForce(g6);
     hand.applyConstraintForce(g6);
     lever.applyConstraintForce(g1);
-    for (sim::RigidObject* o : {&ball, &lever, &hand}) o->integrate(0.001);
+    for (cs::RigidObject* o : {&ball, &lever, &hand}) o->integrate(0.001);
     grasps.release(handle);
     handle = grasps.grasp({2, &hand, 0}, 0);
   };

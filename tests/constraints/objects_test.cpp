@@ -1,7 +1,7 @@
-// Rigid objects (sim::RigidObject), hinge limits and grasps through the ConstraintSolver (thesis 3.2,
+// Rigid objects (constraints::RigidObject), hinge limits and grasps through the ConstraintSolver (thesis 3.2,
 // 4.3.1, Fig. 3.6): each test steps free motion → solver → integration, like the World.
 #include "object_step.hpp"
-#include "mannequin/sim/rigid_object.hpp"
+#include "mannequin/constraints/objects.hpp"
 
 #include <gtest/gtest.h>
 
@@ -32,7 +32,7 @@ using mannequin::testing::kGravity;
 class PlaneContacts final : public cs::RowProducer {
  public:
   struct Point {
-    const sim::RigidObject* object;
+    const cs::RigidObject* object;
     int system;
     Vector3 local;   // body frame
     double radius;   // sphere radius at the point (0: a vertex)
@@ -129,8 +129,8 @@ class TestHand final : public cs::ConstrainedSystem, public cs::BodyFrames {
   Eigen::VectorXd qdot_free_, qdot_, gamma_;
 };
 
-sim::RigidObjectSpec ballSpec(const Vector3& p) {
-  sim::RigidObjectSpec s;
+cs::RigidObjectSpec ballSpec(const Vector3& p) {
+  cs::RigidObjectSpec s;
   s.name = "ball";
   s.pose.p = p;
   s.mass = 0.45;
@@ -142,10 +142,10 @@ sim::RigidObjectSpec ballSpec(const Vector3& p) {
 TEST(RigidObject, PointJacobianMatchesFiniteDifferencesFree) {
   std::mt19937 rng(3);
   std::uniform_real_distribution<double> u(-1, 1);
-  sim::RigidObjectSpec spec;
+  cs::RigidObjectSpec spec;
   spec.name = "box";
   spec.pose = SE3(mannequin::math::expSO3(Vector3(0.3, -0.7, 1.1)), Vector3(0.2, -0.1, 0.9));
-  sim::RigidObject obj(spec);
+  cs::RigidObject obj(spec);
   Eigen::Matrix3Xd J(3, 6);
   for (int trial = 0; trial < 20; ++trial) {
     const Vector3 pl(u(rng), u(rng), u(rng));
@@ -163,11 +163,11 @@ TEST(RigidObject, PointJacobianMatchesFiniteDifferencesFree) {
 }
 
 TEST(RigidObject, PointJacobianMatchesFiniteDifferencesHinge) {
-  sim::RigidObjectSpec spec;
+  cs::RigidObjectSpec spec;
   spec.name = "door";
   spec.pose.p = Vector3(0.45, 0.3, 1.0);
   spec.hinge = mannequin::collision::HingeSpec{Vector3(0.2, 0.1, 1.0), Vector3(0, 0.3, 0), -1, 1};
-  sim::RigidObject obj(spec);
+  cs::RigidObject obj(spec);
   Eigen::Matrix3Xd J(3, 1);
   for (double theta : {-0.5, 0.0, 0.7}) {
     obj.setAngle(theta);
@@ -189,7 +189,7 @@ TEST(RigidObject, PointJacobianMatchesFiniteDifferencesHinge) {
 
 // b = diag(I/τ, m/τ): a free body falls at the terminal speed g τ at once (first-order dynamics).
 TEST(RigidObject, FallsAtTerminalSpeedGTau) {
-  sim::RigidObject ball(ballSpec(Vector3(0, 0, 2)));
+  cs::RigidObject ball(ballSpec(Vector3(0, 0, 2)));
   cs::ConstraintSolver solver({&ball});
   for (int k = 0; k < 100; ++k) {
     ball.computeFreeMotion(kGravity, kDt);
@@ -203,7 +203,7 @@ TEST(RigidObject, FallsAtTerminalSpeedGTau) {
 // Fig. 3.6: a 0.45 kg ball dropped on a table top comes to rest on it; the contact force is its weight.
 TEST(RigidObject, BallRestsOnTableWithItsWeightAsContactForce) {
   const double top = 0.75, r = 0.11;
-  sim::RigidObject ball(ballSpec(Vector3(0.9, 0.2, top + r + 0.01)));
+  cs::RigidObject ball(ballSpec(Vector3(0.9, 0.2, top + r + 0.01)));
   cs::ConstraintSolver solver({&ball});
   PlaneContacts table({{&ball, 0, Vector3::Zero(), r}}, Vector3::UnitZ(), top, 0.8, Vector3::UnitX());
   solver.addProducer(&table);
@@ -229,14 +229,14 @@ double slideOnSlope(double mu, double seconds) {
   const double alpha = 20 * M_PI / 180;
   const Vector3 n(-std::sin(alpha), 0, std::cos(alpha));  // the slope rises towards +x
   const Vector3 down_slope(-std::cos(alpha), 0, -std::sin(alpha));
-  sim::RigidObjectSpec spec;
+  cs::RigidObjectSpec spec;
   spec.name = "box";
   spec.mass = 2.0;
   spec.inertia = Vector3(0.01, 0.01, 0.015);
   const Vector3 half(0.1, 0.1, 0.05);
   spec.pose.R = Eigen::AngleAxisd(-alpha, Vector3::UnitY()).toRotationMatrix();  // R e_z = n
   spec.pose.p = (half.z() + 0.001) * n;
-  sim::RigidObject box(spec);
+  cs::RigidObject box(spec);
   std::vector<PlaneContacts::Point> pts;
   for (int c = 0; c < 4; ++c)
     pts.push_back({&box, 0, Vector3((c & 1) ? half.x() : -half.x(), (c & 2) ? half.y() : -half.y(), -half.z()), 0.0});
@@ -275,18 +275,18 @@ TEST(RigidObject, BoxOnSlopeSlidesWithLowFriction) {
 // A door on a vertical hinge pushed by a horizontal point force turns about its axis only, at
 // θ̇ = a·(r × F)/b, and stops at its upper limit.
 TEST(RigidObject, DoorTurnsAboutItsHingeAndStopsAtTheLimit) {
-  sim::RigidObjectSpec spec;
+  cs::RigidObjectSpec spec;
   spec.name = "door";
   spec.mass = 20;
   spec.inertia = Vector3(20 * (0.81 + 4) / 12, 20 * (4 + 0.0016) / 12, 20 * (0.81 + 0.0016) / 12);
   spec.pose.p = Vector3(0.45, 0, 1.0);  // leaf along x from the axis
   spec.hinge = mannequin::collision::HingeSpec{Vector3::UnitZ(), Vector3::Zero(), 0.0, 100 * M_PI / 180};
-  sim::RigidObject door(spec);
+  cs::RigidObject door(spec);
   const double b = door.friction()(0, 0);
   // I_axis = Izz + m (0.45)²
   EXPECT_NEAR(b, (spec.inertia.z() + 20 * 0.45 * 0.45) / 0.05, 1e-9);
   cs::ConstraintSolver solver({&door});
-  sim::HingeLimitRows limits({{&door, 0}});
+  cs::HingeLimitRows limits({{&door, 0}});
   solver.addProducer(&limits);
   double worst = 0;
   for (int k = 0; k < 12000; ++k) {
@@ -317,7 +317,7 @@ TEST(RigidObject, DoorTurnsAboutItsHingeAndStopsAtTheLimit) {
 // A lever on a horizontal pivot, centre of mass above it, falls onto its end stop and rests there;
 // the stop holds the gravity torque.
 TEST(RigidObject, LeverRestsOnItsEndStop) {
-  sim::RigidObjectSpec spec;
+  cs::RigidObjectSpec spec;
   spec.name = "lever";
   spec.mass = 0.3;
   spec.inertia = Vector3(0.001, 0.001, 0.0001);
@@ -326,9 +326,9 @@ TEST(RigidObject, LeverRestsOnItsEndStop) {
   spec.hinge = mannequin::collision::HingeSpec{Vector3::UnitY(), Vector3(0.7, -0.8, 0.9), -M_PI / 6, M_PI / 6};
   // tilt the centre of mass slightly towards +x so gravity turns the lever towards +θ about y
   spec.pose.p = Vector3(0.7, -0.8, 0.9) + Eigen::AngleAxisd(0.05, Vector3::UnitY()) * Vector3(0, 0, 0.125);
-  sim::RigidObject lever(spec);
+  cs::RigidObject lever(spec);
   cs::ConstraintSolver solver({&lever});
-  sim::HingeLimitRows limits({{&lever, 0}});
+  cs::HingeLimitRows limits({{&lever, 0}});
   solver.addProducer(&limits);
   double worst = 0;
   for (int k = 0; k < 5000; ++k) {
@@ -353,14 +353,14 @@ TEST(RigidObject, LeverRestsOnItsEndStop) {
 // and it falls when released.
 TEST(Grasp, HeldObjectFollowsTheHandAndWeighsOnIt) {
   TestHand hand(SE3(Matrix3::Identity(), Vector3(0, 0, 1.2)), 2.0, 200.0);
-  sim::RigidObjectSpec spec;
+  cs::RigidObjectSpec spec;
   spec.name = "tray";
   spec.mass = 0.6;
   spec.inertia = Vector3(0.003, 0.006, 0.009);
   spec.pose = SE3(Eigen::AngleAxisd(0.3, Vector3::UnitZ()).toRotationMatrix(), Vector3(0.05, 0.02, 1.1));
-  sim::RigidObject tray(spec);
+  cs::RigidObject tray(spec);
   cs::ConstraintSolver solver({&hand, &tray});
-  sim::GraspRows grasps({&tray}, {1}, 6);
+  cs::GraspRows grasps({&tray}, {1}, 6);
   solver.addProducer(&grasps);
   const int g = grasps.grasp({0, &hand, 0}, 0);
   ASSERT_GE(g, 0);
@@ -438,7 +438,7 @@ TEST(RigidObject, MakeObjectsFromAScene) {
       "    shape: {type: capsule, radius: 0.012, length: 0.2}\n",
       "test.yaml");
   std::vector<int> index;
-  const std::vector<sim::RigidObject> objects = sim::makeObjects(scene, &index, 0.05);
+  const std::vector<cs::RigidObject> objects = cs::makeObjects(scene, &index, 0.05);
   ASSERT_EQ(objects.size(), 2u);
   EXPECT_EQ(index, (std::vector<int>{2, 3}));
   EXPECT_EQ(objects[0].name(), "ball");
@@ -457,7 +457,7 @@ struct SceneRig {
     const char* root = std::getenv("MANNEQUIN_SOURCE_DIR");
     scene = mannequin::collision::loadScene(std::string(root ? root : ".") + "/configs/scenes/" + file);
     std::vector<int> index;
-    objects = sim::makeObjects(scene, &index, 0.05);
+    objects = cs::makeObjects(scene, &index, 0.05);
     cw.addScene(scene);
     std::vector<cs::ConstrainedSystem*> systems;
     for (auto& o : objects) systems.push_back(&o);
@@ -466,7 +466,7 @@ struct SceneRig {
       bindings[b].static_pose = cw.bodyPose(b);
       bindings[b].margin = cw.margin(b);
     }
-    std::vector<sim::HingeLimitRows::Entry> hinged;
+    std::vector<cs::HingeLimitRows::Entry> hinged;
     for (std::size_t i = 0; i < objects.size(); ++i) {
       const int b = cw.findBody("scene/" + scene.bodies[index[i]].name);
       object_body.push_back(b);
@@ -476,7 +476,7 @@ struct SceneRig {
       hinged.push_back({&objects[i], static_cast<int>(i)});
     }
     contacts = std::make_unique<cs::ContactRows>(bindings);
-    limits = std::make_unique<sim::HingeLimitRows>(hinged);
+    limits = std::make_unique<cs::HingeLimitRows>(hinged);
     solver = std::make_unique<cs::ConstraintSolver>(systems);
     solver->addProducer(contacts.get());
     solver->addProducer(limits.get());
@@ -509,11 +509,11 @@ struct SceneRig {
     return fz;
   }
   mannequin::collision::SceneSpec scene;
-  std::vector<sim::RigidObject> objects;
+  std::vector<cs::RigidObject> objects;
   mannequin::collision::CollisionWorld cw;
   std::vector<int> object_body;
   std::unique_ptr<cs::ContactRows> contacts;
-  std::unique_ptr<sim::HingeLimitRows> limits;
+  std::unique_ptr<cs::HingeLimitRows> limits;
   std::unique_ptr<cs::ConstraintSolver> solver;
   mannequin::collision::ContactSet set;
 };
@@ -541,8 +541,8 @@ TEST(RigidObject, DoorLeverSceneReachesItsStops) {
   const int door = rig.object("door"), lever = rig.object("lever");
   ASSERT_GE(door, 0);
   ASSERT_GE(lever, 0);
-  sim::RigidObject& D = rig.objects[door];
-  sim::RigidObject& L = rig.objects[lever];
+  cs::RigidObject& D = rig.objects[door];
+  cs::RigidObject& L = rig.objects[lever];
   L.setAngle(0.02);  // off its unstable upright balance
   for (int k = 0; k < 6000; ++k) {
     // 60 N on the leaf's latch end, along its −x normal (the opening direction)
@@ -559,17 +559,17 @@ TEST(RigidObject, DoorLeverSceneReachesItsStops) {
 }
 
 TEST(RigidObject, BadSpecsAreRefused) {
-  sim::RigidObjectSpec s = ballSpec(Vector3::Zero());
+  cs::RigidObjectSpec s = ballSpec(Vector3::Zero());
   s.mass = -1;
-  EXPECT_THROW(sim::RigidObject{s}, std::invalid_argument);
+  EXPECT_THROW(cs::RigidObject{s}, std::invalid_argument);
   s = ballSpec(Vector3::Zero());
   s.time_constant = std::nan("");
-  EXPECT_THROW(sim::RigidObject{s}, std::invalid_argument);
+  EXPECT_THROW(cs::RigidObject{s}, std::invalid_argument);
   s = ballSpec(Vector3::Zero());
   s.hinge = mannequin::collision::HingeSpec{Vector3::Zero(), Vector3::Zero(), -1, 1};
-  EXPECT_THROW(sim::RigidObject{s}, std::invalid_argument);
+  EXPECT_THROW(cs::RigidObject{s}, std::invalid_argument);
   s.hinge = mannequin::collision::HingeSpec{Vector3::UnitZ(), Vector3::Zero(), 0.1, 1};
-  EXPECT_THROW(sim::RigidObject{s}, std::invalid_argument);
+  EXPECT_THROW(cs::RigidObject{s}, std::invalid_argument);
 }
 
 }  // namespace

@@ -28,7 +28,7 @@ WorldCheckpoint World::checkpoint() const {
     c.mannequins.push_back(std::move(mc));
   }
   for (int i = 0; i < numObjects(); ++i) {
-    const RigidObject& o = object(i);
+    const constraints::RigidObject& o = object(i);
     c.objects.push_back({o.name(), o.hinged(), o.pose(), o.angle()});
   }
   return c;
@@ -73,7 +73,7 @@ std::vector<std::string> World::restore(const WorldCheckpoint& c) {
     fail("it has " + std::to_string(c.objects.size()) + " object(s), the World " + std::to_string(numObjects()));
   std::vector<const ObjectCheckpoint*> obj(c.objects.size(), nullptr);
   for (int i = 0; i < numObjects(); ++i) {
-    const RigidObject& o = object(i);
+    const constraints::RigidObject& o = object(i);
     for (const ObjectCheckpoint& oc : c.objects)
       if (oc.name == o.name()) obj[static_cast<std::size_t>(i)] = &oc;
     const ObjectCheckpoint* oc = obj[static_cast<std::size_t>(i)];
@@ -121,7 +121,7 @@ std::vector<std::string> World::restore(const WorldCheckpoint& c) {
     }
   }
   for (int i = 0; i < numObjects(); ++i) {
-    RigidObject& o = object(i);
+    constraints::RigidObject& o = object(i);
     const ObjectCheckpoint& oc = *obj[static_cast<std::size_t>(i)];
     if (o.hinged()) o.setAngle(oc.angle);
     else o.setPose(oc.pose);

@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "mannequin/core/check.hpp"
 #include "mannequin/math/pinv.hpp"
 
 namespace mannequin::sim {
@@ -23,16 +24,14 @@ KinematicTracker::KinematicTracker(const skeleton::Model& model, std::vector<int
 }
 
 void KinematicTracker::setPosture(const skeleton::VectorX& q_posture) {
-  if (q_posture.size() != model_.nq || !q_posture.allFinite())
-    throw std::invalid_argument("tracker: posture of size " + std::to_string(q_posture.size()) + " (expected " +
-                                std::to_string(model_.nq) + ") or with non-finite values");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q_posture.size(), model_.nq, "posture q_posture");
+  if (!q_posture.allFinite()) throw std::invalid_argument("tracker: posture with non-finite values");
   q_posture_ = q_posture;
 }
 
 void KinematicTracker::reset(const skeleton::VectorX& q) {
-  if (q.size() != model_.nq || !q.allFinite())
-    throw std::invalid_argument("tracker: configuration of size " + std::to_string(q.size()) + " (expected " +
-                                std::to_string(model_.nq) + ") or with non-finite values");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q.size(), model_.nq, "configuration q");
+  if (!q.allFinite()) throw std::invalid_argument("tracker: configuration with non-finite values");
   q_ = q;
   qdot_ = skeleton::VectorX::Zero(model_.nv);
   skeleton::forwardKinematics(model_, data_, q_);

@@ -47,7 +47,7 @@ struct GuideRows::Geometry {
   double theta = 0.0;
 };
 
-GuideRows::GuideRows(std::vector<const RigidObject*> objects, std::vector<int> object_systems, double activation,
+GuideRows::GuideRows(std::vector<const constraints::RigidObject*> objects, std::vector<int> object_systems, double activation,
                      double recovery_speed)
     : objects_(std::move(objects)), systems_(std::move(object_systems)), activation_(activation), recovery_speed_(recovery_speed) {
   if (objects_.size() != systems_.size()) throw std::invalid_argument("GuideRows: objects and object_systems differ in size");
@@ -84,7 +84,7 @@ bool GuideRows::supports(const control::MechanismSpec& spec, std::string* why) {
 void GuideRows::attach(int object, const control::MechanismSpec& spec) {
   if (object < 0 || object >= static_cast<int>(objects_.size()))
     throw std::invalid_argument("GuideRows::attach: no object " + std::to_string(object));
-  const RigidObject& o = *objects_[static_cast<std::size_t>(object)];
+  const constraints::RigidObject& o = *objects_[static_cast<std::size_t>(object)];
   if (o.hinged()) throw std::invalid_argument("guide on '" + o.name() + "': a hinged object is guided by its hinge already");
   std::string why;
   if (!supports(spec, &why)) throw std::invalid_argument("guide on '" + o.name() + "': " + why);
@@ -171,7 +171,7 @@ void GuideRows::addRows(int id, double /*dt*/, constraints::RowSet& rows) {
   for (std::size_t k = 0; k < guides_.size(); ++k) {
     const Guide& g = guides_[k];
     if (!g.active) continue;
-    const RigidObject& obj = *objects_[k];
+    const constraints::RigidObject& obj = *objects_[k];
     const int sys = systems_[k], nv = obj.nv();
     const Geometry m = measure(static_cast<int>(k));
     const SE3& oMb = g.spec.base;

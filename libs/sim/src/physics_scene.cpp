@@ -28,7 +28,7 @@ void World::buildPhysics() {
   }
   // the scene's movable bodies with a mass: rigid objects, systems after the mannequins
   std::vector<int> object_spec;
-  P.objects = makeObjects(scene, &object_spec, pc.object_time_constant);
+  P.objects = constraints::makeObjects(scene, &object_spec, pc.object_time_constant);
   for (std::size_t i = 0; i < P.objects.size(); ++i) {
     const int b = P.cw.findBody("scene/" + scene.bodies[static_cast<std::size_t>(object_spec[i])].name);
     if (b < 0) throw std::logic_error("sim: object '" + P.objects[i].name() + "' has no collision body");
@@ -87,8 +87,8 @@ void World::buildPhysics() {
     }
   P.solver->addProducer(P.contacts.get());
   // hinge limits of the hinged objects, grasps of any object by any mannequin body
-  std::vector<HingeLimitRows::Entry> hinged;
-  std::vector<const RigidObject*> all_objects;
+  std::vector<constraints::HingeLimitRows::Entry> hinged;
+  std::vector<const constraints::RigidObject*> all_objects;
   std::vector<int> object_systems;
   int max_nv = 6;
   for (std::size_t i = 0; i < P.objects.size(); ++i) {
@@ -98,15 +98,15 @@ void World::buildPhysics() {
   }
   for (const MannequinModel& mm : model_.mannequins) max_nv = std::max(max_nv, mm.model.nv);
   if (!hinged.empty()) {
-    P.hinges = std::make_unique<HingeLimitRows>(std::move(hinged));
+    P.hinges = std::make_unique<constraints::HingeLimitRows>(std::move(hinged));
     P.solver->addProducer(P.hinges.get());
   }
   if (!P.objects.empty()) {
     P.guides = std::make_unique<GuideRows>(all_objects, object_systems);
     P.solver->addProducer(P.guides.get());
-    P.grasps = std::make_unique<GraspRows>(std::move(all_objects), std::move(object_systems), max_nv);
+    P.grasps = std::make_unique<constraints::GraspRows>(std::move(all_objects), std::move(object_systems), max_nv);
     P.solver->addProducer(P.grasps.get());
-    P.grasp_records.assign(8, {});  // GraspRows' default max_grasps
+    P.grasp_records.assign(8, {});  // constraints::GraspRows' default max_grasps
   }
   // balance: the support region of each mannequin's feet, its CoM distance, and (balance_rows) its row
   for (std::size_t m = 0; m < mannequins.size(); ++m) {
@@ -150,11 +150,11 @@ const collision::CollisionWorld* World::collisionWorld() const { return data_->p
 const constraints::ConstraintSolver* World::constraintSolver() const { return data_->physics ? data_->physics->solver.get() : nullptr; }
 
 int World::numObjects() const { return data_->physics ? static_cast<int>(data_->physics->objects.size()) : 0; }
-const RigidObject& World::object(int i) const {
+const constraints::RigidObject& World::object(int i) const {
   if (i < 0 || i >= numObjects()) throw std::out_of_range("sim: no object " + std::to_string(i));
   return data_->physics->objects[static_cast<std::size_t>(i)];
 }
-RigidObject& World::object(int i) {
+constraints::RigidObject& World::object(int i) {
   if (i < 0 || i >= numObjects()) throw std::out_of_range("sim: no object " + std::to_string(i));
   return data_->physics->objects[static_cast<std::size_t>(i)];
 }
@@ -177,7 +177,7 @@ int World::grasp(int m, const std::string& frame, const std::string& object_name
   const int o = findObject(object_name);
   if (o < 0) throw std::invalid_argument("sim: grasp: no object '" + object_name + "' (movable scene bodies with a mass)");
   PhysicsData& P = *data_->physics;
-  GraspRows::Hand hand;
+  constraints::GraspRows::Hand hand;
   hand.system = m;
   hand.frames = P.frames[static_cast<std::size_t>(m)].get();
   hand.local = model.frames[static_cast<std::size_t>(f)].joint;

@@ -52,7 +52,7 @@ bool World::computeFreeMotion() {
       ++data_->failed_steps;
     }
   }
-  for (RigidObject& o : P.objects) o.computeFreeMotion(model_.config.physics.gravity, dt);
+  for (constraints::RigidObject& o : P.objects) o.computeFreeMotion(model_.config.physics.gravity, dt);
   return ok;
 }
 

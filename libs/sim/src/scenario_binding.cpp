@@ -120,7 +120,7 @@ void World::stepScenario() {
       }
   }
   for (std::size_t k = 0; k < S.objects.size(); ++k) {
-    const RigidObject& o = object(S.objects[k]);
+    const constraints::RigidObject& o = object(S.objects[k]);
     obs.objects[k].pose = o.pose();
     for (std::size_t i = 0; i < obs.objects[k].values.size(); ++i) {
       const int kind = S.value_kind[k][i];

@@ -45,16 +45,16 @@ struct PhysicsData {
   std::vector<std::unique_ptr<constraints::JointLimitRows>> limits;  // per mannequin (joint_limits on)
   std::vector<std::unique_ptr<constraints::BalanceRows>> balance;    // per mannequin (distance; rows if balance_rows)
   std::vector<std::vector<math::Vector3>> support;     // per mannequin: foot–floor points (capacity preallocated)
-  std::vector<RigidObject> objects;                    // systems nm + i
+  std::vector<constraints::RigidObject> objects;                    // systems nm + i
   std::vector<int> object_body;                        // per object: collision body id
-  std::unique_ptr<HingeLimitRows> hinges;
-  std::unique_ptr<GraspRows> grasps;
+  std::unique_ptr<constraints::HingeLimitRows> hinges;
+  std::unique_ptr<constraints::GraspRows> grasps;
   std::unique_ptr<GuideRows> guides;
   struct GraspRecord {
     int object = -1, mannequin = -1;                   // −1: free slot
     int joint = -1;                                    // joint carrying the grasping frame
   };
-  std::vector<GraspRecord> grasp_records;              // per GraspRows handle
+  std::vector<GraspRecord> grasp_records;              // per constraints::GraspRows handle
   std::unique_ptr<constraints::ConstraintSolver> solver;
   collision::ContactSet set;
   int floor_body = -1;                                 // "scene/floor", −1 if none

@@ -90,7 +90,7 @@ void toWorldState(const sim::World& world, const v1::ContactSet* contacts, bool 
       if (!out.has_mocap()) frameRef(*m, src, *out.mutable_mocap());
     }
   for (int i = 0; i < world.numObjects(); ++i) {
-    const sim::RigidObject& o = world.object(i);
+    const constraints::RigidObject& o = world.object(i);
     v1::ObjectState* os = out.add_objects();
     os->set_name(o.name());
     toMsg(o.pose(), *os->mutable_pose());

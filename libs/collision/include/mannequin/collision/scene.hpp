@@ -21,7 +21,7 @@
 ///     movable: true
 ///     material: rubber
 ///     shapes: [{type: sphere, radius: 0.11}]
-///     mass: 0.45                # optional dynamics of a movable body (sim::RigidObject)
+///     mass: 0.45                # optional dynamics of a movable body (constraints::RigidObject)
 ///   - name: door
 ///     movable: true
 ///     mass: 20
@@ -63,7 +63,7 @@ struct HingeSpec {
   double upper = std::numeric_limits<double>::infinity();   ///< rad (+inf: no limit)
 };
 
-/// First-order dynamics of a movable body (sim::RigidObject). The body frame's origin is taken as the
+/// First-order dynamics of a movable body (constraints::RigidObject). The body frame's origin is taken as the
 /// centre of mass and its axes as the principal axes.
 struct BodyDynamics {
   double mass = 0.0;                             ///< kg, > 0

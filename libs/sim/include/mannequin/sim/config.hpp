@@ -109,7 +109,7 @@ struct PhysicsConfig {
   double force_margin_max = 1000.0;
   /// The multi-contact balance controller (libs/balance, Algorithm 5) in the loop.
   BalanceControllerConfig balance_controller;
-  /// τ of the scene's objects without a `time_constant` (s; sim::RigidObject).
+  /// τ of the scene's objects without a `time_constant` (s; constraints::RigidObject).
   double object_time_constant = 0.05;
   constraints::SolverOptions solver;
 };

@@ -1,7 +1,7 @@
 #pragma once
 /// \file object_guides.hpp
 /// \brief Guides on objects (thesis 4.1.1 "mécanismes virtuels", 4.3.1: the waiter's tray kept level,
-/// the rotor part whose holes are kept aligned, the pin kept on the hole's axis): a free RigidObject's
+/// the rotor part whose holes are kept aligned, the pin kept on the hole's axis): a free constraints::RigidObject's
 /// frame (its body frame, origin at the centre of mass) is kept on the effector manifold of a virtual
 /// mechanism by rows of the World's LCP on the object alone (RowSource::kGuide). Where the control
 /// library's mechanisms (virtual_mechanism.hpp) guide a HAND through a spring, a guide holds the OBJECT
@@ -27,7 +27,7 @@
 
 #include "mannequin/constraints/solver.hpp"
 #include "mannequin/control/virtual_mechanism.hpp"
-#include "mannequin/sim/rigid_object.hpp"
+#include "mannequin/constraints/objects.hpp"
 
 namespace mannequin::sim {
 
@@ -36,7 +36,7 @@ class GuideRows final : public constraints::RowProducer {
   /// `objects[i]` is object i, `object_systems[i]` its system index in the solver.
   /// \throws std::invalid_argument on sizes that differ, a null object, a negative system, activation or
   /// recovery_speed ≤ 0.
-  GuideRows(std::vector<const RigidObject*> objects, std::vector<int> object_systems, double activation = 0.05,
+  GuideRows(std::vector<const constraints::RigidObject*> objects, std::vector<int> object_systems, double activation = 0.05,
             double recovery_speed = 0.3);
   const char* name() const override { return "guides"; }
 
@@ -72,7 +72,7 @@ class GuideRows final : public constraints::RowProducer {
   struct Geometry;  // the relative pose's readings (object_guides.cpp)
   Geometry measure(int object) const;
 
-  std::vector<const RigidObject*> objects_;
+  std::vector<const constraints::RigidObject*> objects_;
   std::vector<int> systems_;
   std::vector<Guide> guides_;
   double activation_, recovery_speed_;

@@ -41,7 +41,7 @@
 #include "mannequin/sim/diagnostics.hpp"
 #include "mannequin/sim/mocap_buffer.hpp"
 #include "mannequin/sim/object_guides.hpp"
-#include "mannequin/sim/rigid_object.hpp"
+#include "mannequin/constraints/objects.hpp"
 #include "mannequin/sim/stepper.hpp"
 #include "mannequin/sim/world_model.hpp"
 
@@ -138,9 +138,9 @@ class World {
   //---- objects of the physics scene (movable bodies with a mass) and grasps ----
   int numObjects() const;
   /// \throws std::out_of_range
-  const RigidObject& object(int i) const;
-  /// For pushes (RigidObject::addForce) and resets between steps.
-  RigidObject& object(int i);
+  const constraints::RigidObject& object(int i) const;
+  /// For pushes (constraints::RigidObject::addForce) and resets between steps.
+  constraints::RigidObject& object(int i);
   /// Index of the object named `name`, −1 if none.
   int findObject(const std::string& name) const;
   /// Collision body id of object i.

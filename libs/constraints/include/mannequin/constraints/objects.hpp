@@ -1,5 +1,5 @@
 #pragma once
-/// \file rigid_object.hpp
+/// \file objects.hpp
 /// \brief Rigid objects of a scene (thesis 3.2, 4.3.1: ball, tray, door, throttle lever) as systems
 /// of the constraint layer, with the same first-order dynamics as the mannequins (thesis 2.4):
 ///   b ν = W_gravity + W_ext + W_c.
@@ -39,7 +39,7 @@
 #include "mannequin/constraints/system.hpp"
 #include "mannequin/math/se3.hpp"
 
-namespace mannequin::sim {
+namespace mannequin::constraints {
 
 struct RigidObjectSpec {
   std::string name;
@@ -197,4 +197,4 @@ class GraspRows final : public constraints::RowProducer {
   Eigen::Matrix3Xd Jp_obj_, Jw_obj_, Jp_hand_, Jw_hand_, J0_, J1_;
 };
 
-}  // namespace mannequin::sim
+}  // namespace mannequin::constraints

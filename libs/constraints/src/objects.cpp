@@ -1,9 +1,9 @@
-#include "mannequin/sim/rigid_object.hpp"
+#include "mannequin/constraints/objects.hpp"
 
 #include <cmath>
 #include <stdexcept>
 
-namespace mannequin::sim {
+namespace mannequin::constraints {
 
 using math::Matrix3;
 using math::SE3;
@@ -334,4 +334,4 @@ Vector3 GraspRows::moment(int handle) const {
   return grasps_[handle].moment;
 }
 
-}  // namespace mannequin::sim
+}  // namespace mannequin::constraints
