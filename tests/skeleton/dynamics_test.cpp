@@ -8,6 +8,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <string>
 
 #include "mannequin/skeleton/kinematics.hpp"
 #include "test_models.hpp"
@@ -209,9 +210,20 @@ TEST(Rnea, ExternalWrenchesAreSubtractedThroughTheJacobianTranspose) {
   jointJacobian(m, d, body, ReferenceFrame::kWorld, J);
   EXPECT_LT((tau1 - (tau0 - J.transpose() * fext[body])).norm(), 1e-10 * tau0.norm());
   // a wrench list of the wrong size is refused with the name of what is wrong
+  // (MANNEQUIN_CHECK_ARGUMENT_SIZE: the function, what, what it got and what was expected)
+  const auto refusal = [](auto&& call) -> std::string {
+    try {
+      call();
+    } catch (const std::invalid_argument& e) {
+      return e.what();
+    }
+    return "no exception";
+  };
   std::vector<Vector6> short_list(2, Vector6::Zero());
-  EXPECT_THROW(rnea(m, d, q, v, a, Vector3::Zero(), &short_list), std::invalid_argument);
-  EXPECT_THROW(rnea(m, d, q, v.head(3), a, Vector3::Zero()), std::invalid_argument);
+  EXPECT_EQ(refusal([&] { rnea(m, d, q, v, a, Vector3::Zero(), &short_list); }),
+            "rnea: external wrenches fext has size 2, expected " + std::to_string(m.joints.size()));
+  EXPECT_EQ(refusal([&] { rnea(m, d, q, v.head(3), a, Vector3::Zero()); }),
+            "rnea: velocity v has size 3, expected " + std::to_string(m.nv));
 }
 
 TEST(SpatialForce, WrenchAtAndMomentAboutAreInverse) {

@@ -221,7 +221,7 @@ void Controller::build(const VectorX& q0) {
 }
 
 void Controller::reset(const VectorX& q0) {
-  if (q0.size() != model_.nq) throw std::invalid_argument("reset: q has size " + std::to_string(q0.size()) + ", expected " + std::to_string(model_.nq));
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q0.size(), model_.nq, "q");
   if (!q0.allFinite()) throw std::invalid_argument("reset: q has non-finite values");
   q_ = q0;
   kinematics_at_q_ = false;
@@ -352,7 +352,7 @@ void Controller::clearJointCoupling() {
 }
 
 void Controller::setPosture(const VectorX& q_d) {
-  if (q_d.size() != model_.nq) throw std::invalid_argument("setPosture: q_d has size " + std::to_string(q_d.size()) + ", expected " + std::to_string(model_.nq));
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q_d.size(), model_.nq, "q_d");
   if (!q_d.allFinite()) throw std::invalid_argument("setPosture: q_d has non-finite values (posture kept)");
   q_d_ = q_d;
 }

@@ -2,20 +2,17 @@
 
 #include <stdexcept>
 
+#include "mannequin/core/check.hpp"
+
 namespace mannequin::control {
 
 namespace {
 SE3 freeFlyerPose(const double* q) { return SE3(math::expSO3(Vector3(q[3], q[4], q[5])), Vector3(q[0], q[1], q[2])); }
-void check(const skeleton::Model& model, const VectorX& q, const VectorX& v) {
-  if (q.size() != model.nq || v.size() != model.nv)
-    throw std::invalid_argument("configuration/velocity of size " + std::to_string(q.size()) + "/" +
-                                std::to_string(v.size()) + ", expected " + std::to_string(model.nq) + "/" +
-                                std::to_string(model.nv));
-}
 }  // namespace
 
 void integrateInPlace(const skeleton::Model& model, const VectorX& q, const VectorX& v, double dt, VectorX& q_out) {
-  check(model, q, v);
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q.size(), model.nq, "configuration q");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(v.size(), model.nv, "velocity v");
   if (q_out.size() != model.nq) q_out.resize(model.nq);
   for (const skeleton::Joint& j : model.joints) {
     switch (j.type) {
@@ -41,7 +38,8 @@ void integrateInPlace(const skeleton::Model& model, const VectorX& q, const Vect
 }
 
 void differenceInPlace(const skeleton::Model& model, const VectorX& q0, const VectorX& q1, VectorX& v_out) {
-  check(model, q0, q1);
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q0.size(), model.nq, "configuration q0");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q1.size(), model.nq, "configuration q1");
   if (v_out.size() != model.nv) v_out.resize(model.nv);
   for (const skeleton::Joint& j : model.joints) {
     switch (j.type) {

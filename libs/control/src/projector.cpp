@@ -4,6 +4,8 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "mannequin/core/check.hpp"
+
 namespace mannequin::control {
 
 const char* toString(ProjectorMethod method) { return method == ProjectorMethod::kSvd ? "svd" : "ldlt"; }
@@ -84,7 +86,7 @@ void WeightedNullSpace::computeWithGram(const Eigen::Ref<const MatrixX>& J, cons
 }
 
 void WeightedNullSpace::projectTorque(const VectorX& g, VectorX& out) {
-  if (g.size() != n_) throw std::invalid_argument("WeightedNullSpace::projectTorque: wrong size");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(g.size(), n_, "torque g");
   if (rows_ == 0 || rank_ == 0) {
     if (&out != &g) out = g;
     return;
@@ -205,8 +207,12 @@ void PriorityGramFactor::compute(const Eigen::Ref<const MatrixX>& G) {
 
 void PriorityGramFactor::projectTorque(const Eigen::Ref<const MatrixX>& J, const VectorX& w_inv, int m, const VectorX& g,
                                        VectorX& out) {
-  if (J.rows() != rows_ || J.cols() != n_ || w_inv.size() != n_ || g.size() != n_ || m < 0 || m > rows_)
-    throw std::invalid_argument("PriorityGramFactor::projectTorque: wrong size");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(J.rows(), rows_, "Jacobian J's rows");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(J.cols(), n_, "Jacobian J's columns");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(w_inv.size(), n_, "inverse weights w_inv");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(g.size(), n_, "torque g");
+  if (m < 0 || m > rows_)
+    throw std::invalid_argument("PriorityGramFactor::projectTorque: m = " + std::to_string(m) + ", expected 0 to " + std::to_string(rows_));
   if (m == 0) {
     if (&out != &g) out = g;
     return;

@@ -6,6 +6,8 @@
 
 #include <Eigen/SVD>
 
+#include "mannequin/core/check.hpp"
+
 namespace mannequin::ik {
 
 namespace {
@@ -60,8 +62,8 @@ const VectorX& PriorityLoop::solve(const std::vector<LinearLevel>& levels, const
     if (!L.J.allFinite() || !L.dx.allFinite()) throw std::invalid_argument(where + ": non-finite Jacobian or Δx");
     total_rows += static_cast<int>(L.J.rows());
   }
-  if (free && free->size() != n_) throw std::invalid_argument("PriorityLoop: free mask has wrong size");
-  if (dtheta0 && dtheta0->size() != n_) throw std::invalid_argument("PriorityLoop: Δθ_0 has wrong size");
+  if (free) MANNEQUIN_CHECK_ARGUMENT_SIZE(free->size(), n_, "free mask");
+  if (dtheta0) MANNEQUIN_CHECK_ARGUMENT_SIZE(dtheta0->size(), n_, "Δθ_0");
   const int p = static_cast<int>(levels.size());
   int clamp_rows = 0;
   if (clamps)

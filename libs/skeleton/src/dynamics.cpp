@@ -3,17 +3,12 @@
 #include <stdexcept>
 #include <string>
 
+#include "mannequin/core/check.hpp"
 #include "mannequin/skeleton/kinematics.hpp"
 
 namespace mannequin::skeleton {
 
 namespace {
-
-void checkSize(Eigen::Index got, Eigen::Index expected, const char* what) {
-  if (got != expected)
-    throw std::invalid_argument(std::string("rnea: ") + what + " has size " + std::to_string(got) + ", expected " +
-                                std::to_string(expected));
-}
 
 // spatial motion cross product V × M, (ω, v) order
 Vector6 crossMotion(const Vector6& V, const Vector6& M) {
@@ -46,9 +41,9 @@ Vector6 inertiaTimes(double m, const Vector3& c, const Matrix3& Ic, const Vector
 
 const VectorX& rnea(const Model& model, Data& data, const VectorX& q, const VectorX& v, const VectorX& a,
                     const Vector3& gravity, const std::vector<Vector6>* fext) {
-  checkSize(v.size(), model.nv, "velocity v");
-  checkSize(a.size(), model.nv, "acceleration a");
-  if (fext) checkSize(static_cast<Eigen::Index>(fext->size()), static_cast<Eigen::Index>(model.joints.size()),
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(v.size(), model.nv, "velocity v");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(a.size(), model.nv, "acceleration a");
+  if (fext) MANNEQUIN_CHECK_ARGUMENT_SIZE(static_cast<Eigen::Index>(fext->size()), static_cast<Eigen::Index>(model.joints.size()),
                       "external wrenches fext");
   computeJointJacobians(model, data, q);
   const size_t nj = model.joints.size();
@@ -86,7 +81,7 @@ const VectorX& rnea(const Model& model, Data& data, const VectorX& q, const Vect
 }
 
 double kineticEnergy(const Model& model, Data& data, const VectorX& q, const VectorX& v) {
-  checkSize(v.size(), model.nv, "velocity v");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(v.size(), model.nv, "velocity v");
   computeJointJacobians(model, data, q);
   for (size_t i = 0; i < model.joints.size(); ++i) {
     const Joint& j = model.joints[i];

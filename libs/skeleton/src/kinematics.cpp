@@ -2,15 +2,11 @@
 
 #include <stdexcept>
 
+#include "mannequin/core/check.hpp"
+
 namespace mannequin::skeleton {
 
 namespace {
-void checkSize(Eigen::Index got, int expected, const char* what) {
-  if (got != expected)
-    throw std::invalid_argument(std::string(what) + " has size " + std::to_string(got) + ", expected " +
-                                std::to_string(expected));
-}
-
 // free-flyer coordinates (p, r) <-> pose
 SE3 freeFlyerPose(const double* q) {
   return SE3(math::expSO3(Vector3(q[3], q[4], q[5])), Vector3(q[0], q[1], q[2]));
@@ -37,7 +33,7 @@ SE3 jointTransform(const Joint& joint, const double* q) {
 }
 
 void forwardKinematics(const Model& model, Data& data, const VectorX& q) {
-  checkSize(q.size(), model.nq, "configuration q");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q.size(), model.nq, "configuration q");
   // product of exponentials down the tree (1.14): oMi = oMparent · placement · exp(ξ q)
   for (size_t i = 0; i < model.joints.size(); ++i) {
     const Joint& j = model.joints[i];
@@ -197,8 +193,8 @@ const Matrix3X& jacobianCenterOfMass(const Model& model, Data& data) {
 }
 
 VectorX integrate(const Model& model, const VectorX& q, const VectorX& v, double dt) {
-  checkSize(q.size(), model.nq, "configuration q");
-  checkSize(v.size(), model.nv, "velocity v");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q.size(), model.nq, "configuration q");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(v.size(), model.nv, "velocity v");
   VectorX out = q;
   for (const Joint& j : model.joints) {
     switch (j.type) {
@@ -221,8 +217,8 @@ VectorX integrate(const Model& model, const VectorX& q, const VectorX& v, double
 }
 
 VectorX difference(const Model& model, const VectorX& q0, const VectorX& q1) {
-  checkSize(q0.size(), model.nq, "configuration q0");
-  checkSize(q1.size(), model.nq, "configuration q1");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q0.size(), model.nq, "configuration q0");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q1.size(), model.nq, "configuration q1");
   VectorX v(model.nv);
   for (const Joint& j : model.joints) {
     switch (j.type) {
@@ -243,7 +239,7 @@ VectorX difference(const Model& model, const VectorX& q0, const VectorX& q1) {
 }
 
 VectorX clampToLimits(const Model& model, const VectorX& q) {
-  checkSize(q.size(), model.nq, "configuration q");
+  MANNEQUIN_CHECK_ARGUMENT_SIZE(q.size(), model.nq, "configuration q");
   return q.cwiseMax(model.lower_limit).cwiseMin(model.upper_limit);
 }
 
