@@ -21,10 +21,12 @@
 // Counters: contacts (mean contact rows per step, measured), active (λ > 0), lcp (LCP size), pivots,
 // warm (share of the LCP solves the warm start answered, 0 pivots),
 // per-stage µs (collision, constraints = rows + assemble + lcp, integrate), max_pen_mm, lcp_failures, failed_steps.
+// Kinetics of the offline runs, per sample (see kineticsCase): BM_Kinetics/solve and BM_Kinetics/sample.
 // With libmujoco-dev: BM_MujocoStep/contacts:N and BM_MujocoTrackingStep/contacts:N, the same scene in MuJoCo
 // at our settled pose (equal contact counts), bare or following the same six targets (see mujocoSweep).
 #include <benchmark/benchmark.h>
 
+#include <chrono>
 #include <cmath>
 #include <cstdlib>
 #include <iterator>
@@ -37,6 +39,8 @@
 #include "mannequin/collision/world.hpp"
 #include "mannequin/control/config.hpp"
 #include "mannequin/math/so3.hpp"
+#include "mannequin/kinetics/kinetics.hpp"
+#include "mannequin/sim/kinetics_recorder.hpp"
 #include "mannequin/sim/world.hpp"
 #include "mannequin/skeleton/anthropometry.hpp"
 #include "mannequin/skeleton/mjcf.hpp"
@@ -656,6 +660,70 @@ static void registerMujocoSweep() {
 }
 static const int kMujocoRegistered = (registerMujocoSweep(), 0);
 #endif
+
+namespace {
+/// The whole-body kinetics of the offline runs (sim::KineticsRecorder, libs/kinetics) on the mannequin
+/// standing on the floor (mocap.yaml, gravity on, targets at the standing pose), settled 500 steps:
+///   solve    World::kineticsInputs + KineticsSolver::solve of its current posture at rest (v = a = 0)
+///   sample   KineticsRecorder::sample (what the offline run adds after every step)
+/// Counters: contacts, grf_over_weight (the solved contact force's vertical part over the weight: at rest
+/// it is 1 when the contacts carry the body), residual_n, and step_us / ratio (a World step of the same
+/// set-up, timed in the same run, and the case's time over it).
+void kineticsCase(benchmark::State& state, bool recorder) {
+  const skeleton::Model model =
+      skeleton::buildMannequin(skeleton::loadMannequinSpec(mannequin::bench::dataFile("configs/mannequins/male_50th.yaml")));
+  skeleton::Data d(model);
+  skeleton::forwardKinematics(model, d, skeleton::standingConfiguration(model));
+  const math::Vector3 gravity(0, 0, -9.81);
+  PhysicsRun run = physicsWorld(ringedScene(model, d, true, 0, kSegmentMargin), "configs/control/mocap.yaml", nullptr, gravity);
+  Driver driver(run, run.targets);
+  for (int i = 0; i < 500; ++i) driver.step();
+  World& w = *run.world;
+  constexpr int kSteps = 200;
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int i = 0; i < kSteps; ++i) driver.step();
+  const double step_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count() / kSteps;
+  if (!w.calibrated(0) || w.failedSteps() > 0) {
+    state.SkipWithError("the standing mannequin is not calibrated or a step failed");
+    return;
+  }
+  std::vector<kinetics::ContactPoint> contacts;
+  std::vector<kinetics::Load> loads;
+  long n = 0;
+  const auto t1 = std::chrono::steady_clock::now();
+  if (recorder) {
+    KineticsRecorder rec(w);
+    for (auto _ : state) {
+      rec.sample(w);
+      ++n;
+    }
+    w.kineticsInputs(0, contacts, loads);
+  } else {
+    kinetics::KineticsOptions options;
+    options.gravity = gravity;
+    kinetics::KineticsSolver solver(w.model(0), options);
+    const math::VectorX zero = math::VectorX::Zero(model.nv);
+    kinetics::KineticsFrame f;
+    for (auto _ : state) {
+      w.kineticsInputs(0, contacts, loads);
+      f = solver.solve(w.q(0), zero, zero, contacts, loads);
+      benchmark::DoNotOptimize(f.contact_force);
+      ++n;
+    }
+    const double weight = model.totalMass() * -gravity.z();
+    state.counters["grf_over_weight"] = f.contact_force.z() / weight;
+    state.counters["residual_n"] = f.residual_force.norm();
+  }
+  const double case_s = n > 0 ? std::chrono::duration<double>(std::chrono::steady_clock::now() - t1).count() / static_cast<double>(n) : 0.0;
+  state.counters["contacts"] = static_cast<double>(contacts.size());
+  state.counters["step_us"] = 1e6 * step_s;
+  state.counters["ratio"] = step_s > 0 ? case_s / step_s : 0.0;
+}
+}  // namespace
+
+static void BM_Kinetics(benchmark::State& state, bool recorder) { kineticsCase(state, recorder); }
+BENCHMARK_CAPTURE(BM_Kinetics, solve, false)->Unit(benchmark::kMicrosecond);
+BENCHMARK_CAPTURE(BM_Kinetics, sample, true)->Unit(benchmark::kMicrosecond);
 
 static void BM_PhysicsStep(benchmark::State& state, int contacts) { contactSweep(state, contacts); }
 static void BM_PhysicsStandingHandsOnTable(benchmark::State& state) { handsOnTable(state); }
