@@ -31,7 +31,7 @@ void World::driveTargets(std::size_t index, double dt) {
     // held ones, as after a stream gap (the actor may have moved while the sim was down)
     const bool was_holding = m.holding_restored;
     m.holding_restored = false;
-    const std::int64_t t = captureTimeNs(model_.sources[static_cast<std::size_t>(k_src)]);
+    const std::int64_t t = sourceCaptureTimeNs(static_cast<std::size_t>(k_src));
     for (std::size_t i = 0; i < m.frames.size(); ++i) {
       DrivenFrame& st = m.frames[i];
       const math::SE3 held = st.target;

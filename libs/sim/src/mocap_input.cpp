@@ -26,8 +26,11 @@ void World::anchor(std::int64_t capture_ns, const std::string& source) {
 
 std::int64_t World::captureTimeNs(const std::string& source) const {
   const int k = findSource(source);
-  if (k < 0) return 0;
-  const SourceData* src = &data_->sources[static_cast<std::size_t>(k)];
+  return k < 0 ? 0 : sourceCaptureTimeNs(static_cast<std::size_t>(k));
+}
+
+std::int64_t World::sourceCaptureTimeNs(std::size_t source) const {
+  const SourceData* src = &data_->sources[source];
   const double dt_ns = model_.config.step * 1e9;
   return src->anchor_capture_ns +
          static_cast<std::int64_t>(std::llround(static_cast<double>(data_->steps - src->anchor_step) * dt_ns)) -
@@ -100,7 +103,7 @@ void World::detectStreamGaps() {
   for (std::size_t k = 0; k < data_->sources.size(); ++k) {
     SourceData& src = data_->sources[k];
     if (const mocap::Frame* f = src.buffer.newest(); f != nullptr && src.anchored && !src.gap &&
-                                                      captureTimeNs(model_.sources[k]) - f->stamp_ns > std::llround(model_.config.occlusion_hold * 1e9)) {
+                                                      sourceCaptureTimeNs(k) - f->stamp_ns > std::llround(model_.config.occlusion_hold * 1e9)) {
       src.gap = true;
       ++data_->glitches.stream_gaps;
     }

@@ -208,6 +208,8 @@ class World {
   //---- mocap input (mocap_input.cpp) ----
   /// Index of the mocap source `name` in model_.sources, −1 if none.
   int findSource(const std::string& name) const { return model_.findSource(name); }
+  /// captureTimeNs of the source with index `source` in model_.sources (the stages know it: no lookup by name).
+  std::int64_t sourceCaptureTimeNs(std::size_t source) const;
   /// Stage: counts the sources whose newest frame got older than occlusion_hold (MocapGlitches::stream_gaps).
   void detectStreamGaps();
   //---- calibration (calibration.cpp) ----
